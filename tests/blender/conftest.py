@@ -1,0 +1,46 @@
+"""Blender test fixtures, shared by every Blender (the real program and bpy modules).
+
+The add-on under test is the packaged dist/kodawari.zip, installed the way a user
+installs it, into a throw-away user scripts folder (BLENDER_USER_SCRIPTS, set by
+tools/run_tests.sh before Blender starts)."""
+
+import os
+import sys
+
+import bpy  # first: importing bpy puts Blender's own modules (addon_utils) on sys.path
+import addon_utils  # noqa: E402
+import pytest
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+
+ADDON_ZIP = os.environ.get("KODAWARI_ADDON_ZIP", os.path.join(ROOT, "dist", "kodawari.zip"))
+
+
+def install_addon():
+    if not os.path.isfile(ADDON_ZIP):
+        raise RuntimeError(f"{ADDON_ZIP} is missing: run `make addon` first")
+    bpy.ops.preferences.addon_install(filepath=ADDON_ZIP, overwrite=True)
+    addon_utils.modules_refresh()
+    addon_utils.enable("kodawari", default_set=True, handle_error=_raise)
+    if "kodawari" not in bpy.context.preferences.addons:
+        raise RuntimeError("the kodawari add-on did not enable")
+
+
+def _raise(exc):
+    raise exc
+
+
+@pytest.fixture(scope="session", autouse=True)
+def addon():
+    install_addon()
+    import kodawari
+
+    yield kodawari
+
+
+@pytest.fixture
+def empty_scene(addon):
+    """A fresh empty file (keeps preferences, so the add-on stays enabled)."""
+    bpy.ops.wm.read_homefile(use_empty=True, use_factory_startup=True)
+    yield bpy.context.scene

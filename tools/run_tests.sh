@@ -1,0 +1,42 @@
+#!/usr/bin/env bash
+# Every test tier, then one summary; exits non-zero when any tier fails.
+#   native   C++ GoogleTest through ctest
+#   python   pytest against kodawari_native, no Blender
+#   blender-3.4  the real program: blender -b ... --python tests/blender/run_pytest.py
+#   bpy-4.5, bpy-5.0  the same test files under Blender as a Python module
+set -uo pipefail
+cd "$(dirname "$0")/.."
+VENV=${VENV:-$PWD/.venv}
+VENV5=${VENV5:-$PWD/.venv-bpy5}
+BUILD=${BUILD:-$PWD/build}
+BLENDER=${BLENDER:-blender}
+REPORTS=$BUILD/test-reports
+rm -rf "$REPORTS"; mkdir -p "$REPORTS"
+export PYTHONDONTWRITEBYTECODE=1
+unset PYTHONPATH
+declare -A status
+
+tier() {  # name, command...
+  local name=$1; shift
+  echo; echo "=== tier: $name"
+  if "$@"; then status[$name]=pass; else status[$name]=FAIL; fi
+}
+
+blender_env() {  # a throw-away user folder per Blender, so nothing leaks between tiers
+  local dir; dir=$(mktemp -d)
+  echo "BLENDER_USER_SCRIPTS=$dir/scripts BLENDER_USER_CONFIG=$dir/config BLENDER_USER_DATAFILES=$dir/data BLENDER_USER_EXTENSIONS=$dir/extensions"
+}
+
+tier native ctest --test-dir "$BUILD" --output-on-failure --output-junit "$REPORTS/native.xml"
+tier python env PYTHONPATH="$PWD/addon/kodawari" "$VENV/bin/python" -m pytest -q -p no:cacheprovider tests/python --junitxml="$REPORTS/python.xml"
+tier blender-3.4 env $(blender_env) "$BLENDER" -b --factory-startup -noaudio --python-exit-code 1 \
+  --python tests/blender/run_pytest.py -- -q tests/blender --junitxml="$REPORTS/blender-3.4.xml"
+tier bpy-4.5 env $(blender_env) "$VENV/bin/python" -m pytest -q -p no:cacheprovider tests/blender \
+  --junitxml="$REPORTS/bpy-4.5.xml"
+if [ -x "$VENV5/bin/python" ]; then
+  tier bpy-5.0 env $(blender_env) "$VENV5/bin/python" -m pytest -q -p no:cacheprovider \
+    tests/blender --junitxml="$REPORTS/bpy-5.0.xml"
+fi
+
+echo; echo "=== summary"
+"$VENV/bin/python" tools/summarize_reports.py "$REPORTS" "${!status[@]}" -- "${status[@]}"
