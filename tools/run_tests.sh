@@ -22,14 +22,11 @@ tier() {  # name, command...
   if "$@"; then status[$name]=pass; else status[$name]=FAIL; fi
 }
 
-blender_env() {  # a throw-away user folder per Blender, so nothing leaks between tiers
-  local dir; dir=$(mktemp -d)
-  echo "BLENDER_USER_SCRIPTS=$dir/scripts BLENDER_USER_CONFIG=$dir/config BLENDER_USER_DATAFILES=$dir/data BLENDER_USER_EXTENSIONS=$dir/extensions"
-}
+source tools/blender_env.sh
 
 tier native ctest --test-dir "$BUILD" --output-on-failure --output-junit "$REPORTS/native.xml"
 tier python env PYTHONPATH="$PWD/addon/kodawari" "$VENV/bin/python" -m pytest -q -p no:cacheprovider tests/python --junitxml="$REPORTS/python.xml"
-tier blender-3.4 env $(blender_env) "$BLENDER" -b --factory-startup -noaudio --python-exit-code 1 \
+tier blender-3.4 env $(blender_env) "$BLENDER" "${BLENDER_ARGS[@]}" \
   --python tests/blender/run_pytest.py -- -q tests/blender --junitxml="$REPORTS/blender-3.4.xml"
 tier bpy-4.5 env $(blender_env) "$VENV/bin/python" -m pytest -q -p no:cacheprovider tests/blender \
   --junitxml="$REPORTS/bpy-4.5.xml"

@@ -8,27 +8,13 @@ import os
 import sys
 
 import bpy  # first: importing bpy puts Blender's own modules (addon_utils) on sys.path
-import addon_utils  # noqa: E402
 import pytest
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
-ADDON_ZIP = os.environ.get("KODAWARI_ADDON_ZIP", os.path.join(ROOT, "dist", "kodawari.zip"))
-
-
-def install_addon():
-    if not os.path.isfile(ADDON_ZIP):
-        raise RuntimeError(f"{ADDON_ZIP} is missing: run `make addon` first")
-    bpy.ops.preferences.addon_install(filepath=ADDON_ZIP, overwrite=True)
-    addon_utils.modules_refresh()
-    addon_utils.enable("kodawari", default_set=True, handle_error=_raise)
-    if "kodawari" not in bpy.context.preferences.addons:
-        raise RuntimeError("the kodawari add-on did not enable")
-
-
-def _raise(exc):
-    raise exc
+sys.path.insert(0, os.path.join(ROOT, "tools"))
+from blender_install_addon import ADDON_ZIP, install_addon  # noqa: E402
 
 
 @pytest.fixture(scope="session", autouse=True)
