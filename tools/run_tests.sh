@@ -26,6 +26,14 @@ source tools/blender_env.sh
 
 tier native ctest --test-dir "$BUILD" --output-on-failure --output-junit "$REPORTS/native.xml"
 tier python env PYTHONPATH="$PWD/addon/kodawari" "$VENV/bin/python" -m pytest -q -p no:cacheprovider tests/python --junitxml="$REPORTS/python.xml"
+pip_install_tier() {  # `pip install .` (scikit-build-core, same CMake) into a scratch folder, then the Python tests on it
+  local target; target=$(mktemp -d -t kodawari-pip-XXXXXX)
+  "$VENV/bin/python" -m pip install -q --no-build-isolation --no-deps --target "$target" \
+      --config-settings=build-dir="$BUILD/pip" . 2> >(grep -v "is ignored: it is neither" >&2) || return 1
+  env PYTHONPATH="$target" "$VENV/bin/python" -m pytest -q -p no:cacheprovider tests/python \
+      --junitxml="$REPORTS/pip-install.xml"
+}
+tier pip-install pip_install_tier
 tier blender-3.4 env $(blender_env) "$BLENDER" "${BLENDER_ARGS[@]}" \
   --python tests/blender/run_pytest.py -- -q tests/blender --junitxml="$REPORTS/blender-3.4.xml"
 tier bpy-4.5 env $(blender_env) "$VENV/bin/python" -m pytest -q -p no:cacheprovider tests/blender \
