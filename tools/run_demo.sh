@@ -6,6 +6,7 @@ cd "$(dirname "$0")/.."
 BLENDER=${BLENDER:-blender}
 source tools/blender_env.sh
 mkdir -p out
+started=$(mktemp); trap 'rm -f "$started"' EXIT
 shopt -s nullglob
 demos=(blend_samples/*_demo.py)
 ((${#demos[@]})) || { echo "no demo scripts in blend_samples/"; exit 1; }
@@ -15,4 +16,4 @@ for demo in "${demos[@]}"; do
     --python tools/blender_install_addon.py --python "$demo" 2>&1 | grep -vE "^(Fra:|Blender quit|Read blend)" || exit 1
 done
 echo; echo "=== demo wrote:"
-find out -maxdepth 1 -type f -newer "$0" -o -maxdepth 1 -type f -print | sort -u | sed 's/^/  /'
+find out -maxdepth 1 -type f -newer "$started" | sort | sed 's/^/  /'
