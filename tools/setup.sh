@@ -56,7 +56,6 @@ make_venv() {  # venv dir, requirements file
   if venv_ready "$1" "$2"; then say "$1 up to date"; return 0; fi
   say "installing $2 into $1 (first time: a few minutes, bpy is large)"
   [ -x "$1/bin/python" ] || "$PYTHON" -m venv "$1" || { dpkg -s python3-venv >/dev/null 2>&1 || die "python venv module missing: apt-get install python3-venv"; }
-  "$1/bin/python" -m pip install -q --upgrade pip >/dev/null
   "$1/bin/python" -m pip install -q -r "$2" 2> >(grep -v "is ignored: it is neither" >&2) || return 1
   cp "$2" "$1/.kodawari-req"
 }
