@@ -39,38 +39,22 @@ Vec3 carry_normal(const Vec3& normal, const Vec3& from, const Vec3& to) {
   return (carried - carried.dot(to) * to).normalized();
 }
 
-Vec3 unit_tangent(const CubicBSpline& curve, Real t) {
-  const Vec3 d = curve.first_derivative(t);
-  const Real speed = d.norm();
-  const Vec3 chord_hint = curve.control_points().back() - curve.control_points().front();
-  const Real scale = chord_hint.norm() + (curve.control_points()[1] - curve.control_points()[0]).norm();
-  if (speed > Real(1e-12) * scale) return d / speed;
-  // A cusp: M'(t) = 0. Use the chord across a small parameter step instead.
-  const Real h = Real(1e-4);
-  const Vec3 chord = curve.point(std::min(Real(1), t + h)) - curve.point(std::max(Real(0), t - h));
-  if (chord.norm() > 0) return chord.normalized();
-  return (curve.control_points()[1] - curve.control_points()[0]).normalized();
-}
-
-FrameList rotation_minimising_frames(const CubicBSpline& curve, const std::vector<Real>& twist,
-                                     const Vec3& start_normal, int samples) {
-  FrameList frames(static_cast<std::size_t>(samples));
-  const Real step = Real(1) / Real(samples - 1);
-  Vec3 x_prev = curve.point(0);
-  Vec3 t_prev = unit_tangent(curve, 0);
-  Vec3 r_prev = start_normal;
-  for (int i = 0; i < samples; ++i) {
-    const Real t = i == samples - 1 ? Real(1) : i * step;
-    Vec3 x = curve.point(t), tangent = unit_tangent(curve, t), r = r_prev;
+void rotation_minimising_frames(const CurveSamples& samples, const Vec3& start_normal, FrameList& frames) {
+  const std::size_t count = samples.origin.size();
+  frames.resize(count);
+  Vec3 r = start_normal;
+  for (std::size_t i = 0; i < count; ++i) {
+    const Vec3& x = samples.origin[i];
+    const Vec3& tangent = samples.tangent[i];
     if (i > 0) {
-      // Double reflection: reflect (r, t) in the bisector plane of x_prev -> x,
-      // then in the plane that maps the reflected tangent onto the new tangent.
-      const Vec3 v1 = x - x_prev;
+      // Reflect (r, t) in the bisector plane of x_prev -> x, then in the plane
+      // that maps the reflected tangent onto the new tangent.
+      const Vec3 v1 = x - samples.origin[i - 1];
       const Real c1 = v1.dot(v1);
-      Vec3 r_left = r_prev, t_left = t_prev;
+      Vec3 r_left = r, t_left = samples.tangent[i - 1];
       if (c1 > 0) {
-        r_left = r_prev - (2 / c1) * v1.dot(r_prev) * v1;
-        t_left = t_prev - (2 / c1) * v1.dot(t_prev) * v1;
+        r_left -= (2 / c1) * v1.dot(r) * v1;
+        t_left -= (2 / c1) * v1.dot(t_left) * v1;
       }
       const Vec3 v2 = tangent - t_left;
       const Real c2 = v2.dot(v2);
@@ -78,24 +62,19 @@ FrameList rotation_minimising_frames(const CubicBSpline& curve, const std::vecto
       // Keep r exactly perpendicular and unit against rounding drift.
       r = (r - r.dot(tangent) * tangent).normalized();
     }
-    Frame& f = frames[static_cast<std::size_t>(i)];
+    Frame& f = frames[i];
     f.origin = x;
     f.e1 = tangent;
     const Vec3 s = tangent.cross(r);
-    if (twist.empty()) {
+    if (samples.roll.empty()) {
       f.e2 = r;
       f.e3 = s;
     } else {
-      const Real angle = curve.blend(twist, t);
-      const Real c = std::cos(angle), sn = std::sin(angle);
+      const Real c = std::cos(samples.roll[i]), sn = std::sin(samples.roll[i]);
       f.e2 = c * r + sn * s;
       f.e3 = c * s - sn * r;
     }
-    x_prev = x;
-    t_prev = tangent;
-    r_prev = r;
   }
-  return frames;
 }
 
 }  // namespace kodawari::ffd
