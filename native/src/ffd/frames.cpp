@@ -42,37 +42,47 @@ Vec3 carry_normal(const Vec3& normal, const Vec3& from, const Vec3& to) {
 void rotation_minimising_frames(const CurveSamples& samples, const Vec3& start_normal, FrameList& frames) {
   const std::size_t count = samples.origin.size();
   frames.resize(count);
+  // Pass 1, independent per step: the two reflection planes. v1 is the chord
+  // x_{i-1} -> x_i; v2 maps the tangent reflected in v1 onto t_i. Each plane
+  // is stored as (normal, 2 / |normal|^2), zero when the reflection is void.
+  for (std::size_t i = 1; i < count; ++i) {
+    const Vec3 v1 = samples.origin[i] - samples.origin[i - 1];
+    const Real c1 = v1.dot(v1);
+    const Real k1 = c1 > 0 ? 2 / c1 : Real(0);
+    const Vec3& t_prev = samples.tangent[i - 1];
+    const Vec3 v2 = samples.tangent[i] - (t_prev - k1 * v1.dot(t_prev) * v1);
+    const Real c2 = v2.dot(v2);
+    // Park the planes in the frames' e1/e3 slots until pass 3 overwrites them.
+    frames[i].e1 = v1 * std::sqrt(k1);
+    frames[i].e3 = v2 * (c2 > 0 ? std::sqrt(2 / c2) : Real(0));
+  }
+  // Pass 2, the only sequential part: r_i = H2 H1 r_{i-1}, two reflections
+  // r <- r - (a . r) a with a = v sqrt(2 / |v|^2). Reflections are orthogonal,
+  // so r stays unit up to rounding (renormalised on output, not fed back).
   Vec3 r = start_normal;
+  frames[0].e2 = r;
+  for (std::size_t i = 1; i < count; ++i) {
+    const Vec3& a1 = frames[i].e1;
+    const Vec3& a2 = frames[i].e3;
+    r -= a1.dot(r) * a1;
+    r -= a2.dot(r) * a2;
+    frames[i].e2 = r;
+  }
+  // Pass 3, independent: exact orthonormal frames, then the twist roll.
   for (std::size_t i = 0; i < count; ++i) {
-    const Vec3& x = samples.origin[i];
-    const Vec3& tangent = samples.tangent[i];
-    if (i > 0) {
-      // Reflect (r, t) in the bisector plane of x_prev -> x, then in the plane
-      // that maps the reflected tangent onto the new tangent.
-      const Vec3 v1 = x - samples.origin[i - 1];
-      const Real c1 = v1.dot(v1);
-      Vec3 r_left = r, t_left = samples.tangent[i - 1];
-      if (c1 > 0) {
-        r_left -= (2 / c1) * v1.dot(r) * v1;
-        t_left -= (2 / c1) * v1.dot(t_left) * v1;
-      }
-      const Vec3 v2 = tangent - t_left;
-      const Real c2 = v2.dot(v2);
-      r = c2 > 0 ? Vec3(r_left - (2 / c2) * v2.dot(r_left) * v2) : r_left;
-      // Keep r exactly perpendicular and unit against rounding drift.
-      r = (r - r.dot(tangent) * tangent).normalized();
-    }
     Frame& f = frames[i];
-    f.origin = x;
+    const Vec3& tangent = samples.tangent[i];
+    const Vec3 normal = (f.e2 - f.e2.dot(tangent) * tangent).normalized();
+    const Vec3 binormal = tangent.cross(normal);
+    f.origin = samples.origin[i];
     f.e1 = tangent;
-    const Vec3 s = tangent.cross(r);
     if (samples.roll.empty()) {
-      f.e2 = r;
-      f.e3 = s;
+      f.e2 = normal;
+      f.e3 = binormal;
     } else {
       const Real c = std::cos(samples.roll[i]), sn = std::sin(samples.roll[i]);
-      f.e2 = c * r + sn * s;
-      f.e3 = c * s - sn * r;
+      f.e2 = c * normal + sn * binormal;
+      f.e3 = c * binormal - sn * normal;
     }
   }
 }
