@@ -19,13 +19,13 @@ constexpr std::size_t kMinBindVerticesPerThread = 512;
 // exact spline by up to ~5e-6 of the length (mostly along the tangent, as the
 // parameter speed varies). Moving t to where P - O(t) is perpendicular to the
 // interpolated e1 makes the rest rebuild exact up to float rounding.
-void refine_on_table(const std::vector<TableSegment>& table, const Vec3& p, std::uint32_t& segment, float& fraction) {
+void refine_on_table(const FrameTable& table, const Vec3& p, std::uint32_t& segment, float& fraction) {
   Real f = fraction;
   int s = static_cast<int>(segment);
   for (int hop = 0; hop < 4; ++hop) {
     const TableSegment& seg = table[static_cast<std::size_t>(s)];
-    const Vec3 o(seg.origin[0], seg.origin[1], seg.origin[2]), d_o(seg.d_origin[0], seg.d_origin[1], seg.d_origin[2]);
-    const Vec3 e1(seg.e1[0], seg.e1[1], seg.e1[2]), d_e1(seg.d_e1[0], seg.d_e1[1], seg.d_e1[2]);
+    const Vec3 o = seg.origin.head<3>().cast<Real>(), d_o = seg.d_origin.head<3>().cast<Real>();
+    const Vec3 e1 = seg.e1.head<3>().cast<Real>(), d_e1 = seg.d_e1.head<3>().cast<Real>();
     for (int iteration = 0; iteration < 4; ++iteration) {
       const Vec3 r = p - o - f * d_o;
       const Vec3 tangent = e1 + f * d_e1;
@@ -94,7 +94,7 @@ AxisBinding::AxisBinding(const Vec3List& control_points, const float* vertices, 
   rest_normal_ = up ? start_normal_from_up(*up, rest_tangent_) : default_start_normal(rest_tangent_);
   FrameList frames;
   rotation_minimising_frames(sampled, rest_normal_, frames);
-  std::vector<TableSegment> table;
+  FrameTable table;
   fill_frame_table(frames, table);
   const ClosestPointFinder finder(curve);
 
@@ -108,10 +108,10 @@ AxisBinding::AxisBinding(const Vec3List& control_points, const float* vertices, 
       if (t > 0 && t < 1) refine_on_table(table, p, c.segment, c.fraction);
       const bool at_head = c.segment == 0 && c.fraction == 0.0f;
       const bool at_tail = c.segment == kTableSegments - 1 && c.fraction == 1.0f;
-      float of[3], e1f[3], e2f[3], e3f[3];
-      table_frame(table[c.segment], c.fraction, of, e1f, e2f, e3f);
-      const Vec3 d = p - Vec3(of[0], of[1], of[2]);
-      const Vec3 e1(e1f[0], e1f[1], e1f[2]), e2(e2f[0], e2f[1], e2f[2]), e3(e3f[0], e3f[1], e3f[2]);
+      const TableFrame frame = table_frame(table[c.segment], c.fraction);
+      const Vec3 d = p - frame.origin.head<3>().cast<Real>();
+      const Vec3 e1 = frame.e1.head<3>().cast<Real>(), e2 = frame.e2.head<3>().cast<Real>(),
+                 e3 = frame.e3.head<3>().cast<Real>();
       if (at_head || at_tail) {
         // Beyond an end: keep the full offset in the end frame, so the part
         // past the axis (snout, fin tip) follows the end rigidly.
@@ -157,7 +157,7 @@ void AxisBinding::deform(const Vec3List& control_points, const std::vector<Real>
   const Vec3 normal = up ? start_normal_from_up(*up, tangent) : carry_normal(rest_normal_, rest_tangent_, tangent);
   FrameList frames;
   rotation_minimising_frames(sampled, normal, frames);
-  std::vector<TableSegment> table;
+  FrameTable table;
   fill_frame_table(frames, table);
 
   const AxisCoordinate* coords = coordinates_.data();
