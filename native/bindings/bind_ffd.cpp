@@ -1,0 +1,188 @@
+// Python face of the control-axis FFD; the contract is FFD_API.md. Thin: checks
+// arrays (ValueError naming the argument), converts, releases the GIL.
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <memory>
+#include <optional>
+#include <stdexcept>
+#include <vector>
+
+#include "arrays.hpp"
+#include "bind.hpp"
+#include "kodawari/ffd/bspline.hpp"
+#include "kodawari/ffd/control_axis.hpp"
+#include "kodawari/ffd/frames.hpp"
+#include "kodawari/ffd/lengths.hpp"
+
+namespace kodawari::bind {
+
+namespace {
+
+using ffd::AxisBinding;
+
+Vec3List to_points(const py::handle& obj, const char* name) {
+  const auto arr = checked_array<double>(obj, name, -1, 3);
+  const double* data = arr.data();
+  Vec3List points(static_cast<std::size_t>(arr.shape(0)));
+  for (std::size_t i = 0; i < points.size(); ++i) points[i] = Vec3(data[3 * i], data[3 * i + 1], data[3 * i + 2]);
+  return points;
+}
+
+Vec3List to_control_points(const py::handle& obj) {
+  Vec3List points = to_points(obj, "control_points");
+  ffd::validate_control_points(points, "control_points");
+  return points;
+}
+
+std::vector<Real> to_twist(const py::handle& obj, std::size_t count) {
+  if (obj.is_none()) return {};
+  const auto arr = checked_array<double>(obj, "twist", static_cast<py::ssize_t>(count), 0);
+  return std::vector<Real>(arr.data(), arr.data() + count);
+}
+
+std::optional<Vec3> to_up(const py::handle& obj) {
+  if (obj.is_none()) return std::nullopt;
+  const auto arr = checked_array<double>(obj, "up", 3, 0);
+  return Vec3(arr.data()[0], arr.data()[1], arr.data()[2]);
+}
+
+py::array_t<double> points_array(const Vec3List& points) {
+  py::array_t<double> out({static_cast<py::ssize_t>(points.size()), py::ssize_t(3)});
+  double* data = out.mutable_data();
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    for (int k = 0; k < 3; ++k) data[3 * i + k] = points[i][k];
+  }
+  return out;
+}
+
+template <typename Field>
+py::array_t<float> coordinate_column(const AxisBinding& binding, Field field) {
+  py::array_t<float> out(static_cast<py::ssize_t>(binding.count()));
+  float* data = out.mutable_data();
+  for (std::size_t i = 0; i < binding.count(); ++i) data[i] = field(i);
+  return out;
+}
+
+}  // namespace
+
+void bind_ffd(py::module_& m) {
+  py::class_<AxisBinding, std::shared_ptr<AxisBinding>>(
+      m, "AxisBinding", "A mesh bound to a control axis: per vertex (t, u, v, w); see ffd_bind.")
+      .def_property_readonly("count", &AxisBinding::count, "number of bound vertices N")
+      .def_property_readonly("control_point_count", &AxisBinding::control_point_count)
+      .def_property_readonly(
+          "t", [](const AxisBinding& b) { return coordinate_column(b, [&](std::size_t i) { return b.parameter(i); }); },
+          "float32 (N,) curve parameter of each vertex's closest curve point, in [0, 1]")
+      .def_property_readonly(
+          "u", [](const AxisBinding& b) { return coordinate_column(b, [&](std::size_t i) { return b.coordinates()[i].u; }); },
+          "float32 (N,) offset along e2")
+      .def_property_readonly(
+          "v", [](const AxisBinding& b) { return coordinate_column(b, [&](std::size_t i) { return b.coordinates()[i].v; }); },
+          "float32 (N,) offset along e3")
+      .def_property_readonly(
+          "w", [](const AxisBinding& b) { return coordinate_column(b, [&](std::size_t i) { return b.coordinates()[i].w; }); },
+          "float32 (N,) offset along e1, non-zero only beyond the curve's ends")
+      .def(
+          "deform",
+          [](const AxisBinding& b, const py::handle& control_points, const py::handle& out, const py::handle& twist,
+             const py::handle& up, unsigned threads) {
+            const Vec3List points = to_control_points(control_points);
+            if (points.size() != static_cast<std::size_t>(b.control_point_count())) {
+              throw py::value_error("control_points must have " + std::to_string(b.control_point_count()) +
+                                    " points, as at bind time");
+            }
+            const std::vector<Real> twist_values = to_twist(twist, points.size());
+            const std::optional<Vec3> up_hint = to_up(up);
+            auto target = checked_output<float>(out, "out", static_cast<py::ssize_t>(b.count()), 3);
+            float* data = target.mutable_data();
+            py::gil_scoped_release release;
+            b.deform(points, twist_values, up_hint, data, threads);
+          },
+          py::arg("control_points"), py::arg("out"), py::arg("twist") = py::none(), py::arg("up") = py::none(),
+          py::arg("threads") = 0,
+          "Write the mesh deformed by new control points into `out` (float32 (N, 3)); the GIL is released.");
+
+  m.def(
+      "ffd_bind",
+      [](const py::handle& control_points, const py::handle& vertices, const py::handle& twist, const py::handle& up) {
+        const Vec3List points = to_control_points(control_points);
+        const std::vector<Real> twist_values = to_twist(twist, points.size());
+        const std::optional<Vec3> up_hint = to_up(up);
+        const auto verts = checked_array<float>(vertices, "vertices", -1, 3);
+        if (verts.shape(0) == 0) throw py::value_error("vertices must not be empty");
+        const float* data = verts.data();
+        const std::size_t count = static_cast<std::size_t>(verts.shape(0));
+        py::gil_scoped_release release;
+        return std::make_shared<AxisBinding>(points, data, count, twist_values, up_hint);
+      },
+      py::arg("control_points"), py::arg("vertices"), py::arg("twist") = py::none(), py::arg("up") = py::none(),
+      "Bind float32 (N, 3) vertices to the clamped cubic B-spline of float64 (n, 3) control points (n >= 4).");
+
+  m.def(
+      "ffd_frames",
+      [](const py::handle& control_points, const py::handle& twist, const py::handle& up, int samples) {
+        const Vec3List points = to_control_points(control_points);
+        const std::vector<Real> twist_values = to_twist(twist, points.size());
+        const std::optional<Vec3> up_hint = to_up(up);
+        if (samples < 2) throw py::value_error("samples must be >= 2");
+        const ffd::CubicBSpline curve(points);
+        const ffd::FrameList frames = ffd::axis_frames(curve, twist_values, up_hint, samples);
+        py::array_t<double> out({static_cast<py::ssize_t>(samples), py::ssize_t(4), py::ssize_t(3)});
+        double* data = out.mutable_data();
+        for (std::size_t i = 0; i < frames.size(); ++i) {
+          const ffd::Frame& f = frames[i];
+          const Vec3* rows[4] = {&f.origin, &f.e1, &f.e2, &f.e3};
+          for (int r = 0; r < 4; ++r) {
+            for (int k = 0; k < 3; ++k) data[12 * i + 3 * r + k] = (*rows[r])[k];
+          }
+        }
+        return out;
+      },
+      py::arg("control_points"), py::arg("twist") = py::none(), py::arg("up") = py::none(), py::arg("samples") = 64,
+      "float64 (samples, 4, 3): origin M(t), e1, e2, e3 at t = linspace(0, 1, samples).");
+
+  m.def(
+      "curve_points",
+      [](const py::handle& control_points, const py::handle& t) {
+        const ffd::CubicBSpline curve(to_control_points(control_points));
+        const auto params = checked_array<double>(t, "t", -1, 0);
+        Vec3List points(static_cast<std::size_t>(params.shape(0)));
+        for (std::size_t i = 0; i < points.size(); ++i) {
+          const double value = params.data()[i];
+          if (value < 0 || value > 1) throw py::value_error("t values must lie in [0, 1]");
+          points[i] = curve.point(value);
+        }
+        return points_array(points);
+      },
+      py::arg("control_points"), py::arg("t"), "float64 (K, 3) curve points at parameters t in [0, 1].");
+
+  m.def(
+      "curve_length",
+      [](const py::handle& control_points) { return ffd::curve_length(ffd::CubicBSpline(to_control_points(control_points))); },
+      py::arg("control_points"), "Arc length of the clamped cubic B-spline.");
+
+  m.def(
+      "preserve_lengths",
+      [](const py::handle& points, const py::handle& rest_lengths, long moved_index) {
+        const Vec3List p = to_points(points, "points");
+        const auto rest = checked_array<double>(rest_lengths, "rest_lengths", -1, 0);
+        const std::vector<Real> lengths(rest.data(), rest.data() + rest.shape(0));
+        return points_array(ffd::preserve_lengths(p, lengths, moved_index));
+      },
+      py::arg("points"), py::arg("rest_lengths"), py::arg("moved_index"),
+      "The seed's distance-keeping pass: keep points[moved_index], restore every rest length toward both ends.");
+
+  m.def(
+      "preserve_lengths_from_head",
+      [](const py::handle& points, const py::handle& rest_lengths) {
+        const Vec3List p = to_points(points, "points");
+        const auto rest = checked_array<double>(rest_lengths, "rest_lengths", -1, 0);
+        const std::vector<Real> lengths(rest.data(), rest.data() + rest.shape(0));
+        return points_array(ffd::preserve_lengths_from_head(p, lengths));
+      },
+      py::arg("points"), py::arg("rest_lengths"), "Pin point 0 and restore every rest length tailward.");
+}
+
+}  // namespace kodawari::bind

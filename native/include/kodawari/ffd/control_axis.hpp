@@ -1,0 +1,50 @@
+// The control-axis FFD (SEEDS §1, Yamanogue's axial deformation): bind a mesh to
+// a control curve once, then rebuild it from any new pose of the curve.
+#pragma once
+
+#include <cstddef>
+#include <optional>
+#include <vector>
+
+#include "kodawari/common.hpp"
+#include "kodawari/ffd/bspline.hpp"
+#include "kodawari/ffd/frame_table.hpp"
+#include "kodawari/ffd/frames.hpp"
+
+namespace kodawari::ffd {
+
+// Throws std::invalid_argument naming "twist" unless it is empty or holds
+// `count` finite values.
+void validate_twist(const std::vector<Real>& twist, int count);
+
+// Frames of a curve at `samples` evenly spaced t; the start e2 comes from `up`
+// when given, else from default_start_normal.
+FrameList axis_frames(const CubicBSpline& curve, const std::vector<Real>& twist, const std::optional<Vec3>& up,
+                      int samples);
+
+class AxisBinding {
+ public:
+  // vertices: `count` packed float xyz triples. Throws std::invalid_argument
+  // (naming the argument) on bad input.
+  AxisBinding(const Vec3List& control_points, const float* vertices, std::size_t count,
+              const std::vector<Real>& twist, const std::optional<Vec3>& up, unsigned threads = 0);
+
+  std::size_t count() const { return coordinates_.size(); }
+  int control_point_count() const { return control_point_count_; }
+  const std::vector<AxisCoordinate>& coordinates() const { return coordinates_; }
+  float parameter(std::size_t i) const;  // t in [0, 1]
+
+  // Writes count() deformed xyz triples to `out`. Allocates only the fixed-size
+  // frame table; every vertex is computed by one thread with the same
+  // arithmetic, so the result does not depend on `threads` (0 = all cores).
+  void deform(const Vec3List& control_points, const std::vector<Real>& twist, const std::optional<Vec3>& up,
+              float* out, unsigned threads = 0) const;
+
+ private:
+  int control_point_count_ = 0;
+  Vec3 rest_tangent_ = Vec3::UnitX();
+  Vec3 rest_normal_ = Vec3::UnitY();
+  std::vector<AxisCoordinate> coordinates_;
+};
+
+}  // namespace kodawari::ffd

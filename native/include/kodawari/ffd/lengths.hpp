@@ -1,0 +1,23 @@
+// Keeping control-point distances so the body does not stretch (SEEDS §1,
+// "Keeping control-point distances"), and the rest lengths they keep.
+#pragma once
+
+#include <vector>
+
+#include "kodawari/common.hpp"
+
+namespace kodawari::ffd {
+
+// |P(i+1) - P(i)| for i = 0..n-2.
+std::vector<Real> segment_lengths(const Vec3List& points);
+
+// The seed's pass: keep points[moved_index]; walking toward the head, put each
+// point on the segment from itself toward its already placed tail-side
+// neighbour at the rest distance; then the same toward the tail.
+// Throws std::invalid_argument naming the argument on bad input.
+Vec3List preserve_lengths(const Vec3List& points, const std::vector<Real>& rest_lengths, long moved_index);
+
+// Pins point 0 and propagates tailward (the swim drives every point each frame).
+Vec3List preserve_lengths_from_head(const Vec3List& points, const std::vector<Real>& rest_lengths);
+
+}  // namespace kodawari::ffd
