@@ -96,17 +96,6 @@ TEST(BodyWave, SameInputsGiveBitIdenticalOutputs) {
   for (std::size_t i = 0; i < a.size(); ++i) EXPECT_EQ(a[i], b[i]);
 }
 
-TEST(KeepLengths, WalksFromAPinnedHead) {
-  Vec3List targets{{0, 0, 0}, {1, 1, 0}, {2, 0, 0}, {5, 0, 0}};
-  const std::vector<Real> lengths{1, 1, 1};
-  const Vec3List out = keep_lengths_from_head(targets, lengths);
-  EXPECT_EQ(out[0], targets[0]);
-  for (int i = 1; i < 4; ++i) EXPECT_NEAR((out[i] - out[i - 1]).norm(), 1.0, 1e-12);
-  // Each point lies on the segment from its placed neighbour toward its target.
-  const Vec3 d1 = (out[1] - out[0]).normalized(), t1 = (targets[1] - out[0]).normalized();
-  EXPECT_NEAR(d1.dot(t1), 1.0, 1e-12);
-}
-
 TEST(AccumulatePhase, ConstantFrequencyGivesTwoPiFT) {
   const std::vector<Real> f(25, 2.0);
   const std::vector<Real> phase = accumulate_phase(f, 1.0 / 24.0, 0.0);

@@ -2,7 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <stdexcept>
+
+#include "kodawari/ffd/lengths.hpp"
 
 namespace kodawari::swim {
 
@@ -29,21 +30,6 @@ std::vector<Real> arc_fractions(const Vec3List& points) {
   return s;
 }
 
-Vec3List keep_lengths_from_head(const Vec3List& targets, const std::vector<Real>& rest_lengths) {
-  if (rest_lengths.size() + 1 != targets.size()) {
-    throw std::invalid_argument("keep_lengths_from_head: need one rest length per segment");
-  }
-  Vec3List out(targets);
-  for (std::size_t i = 1; i < out.size(); ++i) {
-    const Vec3 toward = targets[i] - out[i - 1];
-    const Real norm = toward.norm();
-    // A target on top of its neighbour gives no direction: keep the rest one.
-    const Vec3 dir = norm > Real(1e-12) ? Vec3(toward / norm) : Vec3(targets[i] - targets[i - 1]).normalized();
-    out[i] = out[i - 1] + rest_lengths[i - 1] * dir;
-  }
-  return out;
-}
-
 Vec3List body_axis(const Vec3List& rest, const Vec3& bend_direction, Real body_length, const BodyWave& wave,
                    Real phase) {
   const std::size_t n = rest.size();
@@ -55,8 +41,7 @@ Vec3List body_axis(const Vec3List& rest, const Vec3& bend_direction, Real body_l
   for (std::size_t i = 0; i < n; ++i) targets[i] = rest[i] + wanted[i] * bend_direction;
   if (!wave.preserve_length || n < 2) return targets;
 
-  std::vector<Real> rest_lengths(n - 1);
-  for (std::size_t i = 0; i + 1 < n; ++i) rest_lengths[i] = (rest[i + 1] - rest[i]).norm();
+  const std::vector<Real> rest_lengths = ffd::segment_lengths(rest);
 
   // The distance-keeping walk shortens the sideways offsets a little (each point is
   // pulled toward its neighbour); a few fixed-point passes aim the targets further
@@ -66,7 +51,7 @@ Vec3List body_axis(const Vec3List& rest, const Vec3& bend_direction, Real body_l
   constexpr int kPasses = 8;
   for (int pass = 0; pass < kPasses; ++pass) {
     for (std::size_t i = 0; i < n; ++i) targets[i] = rest[i] + aim[i] * bend_direction;
-    placed = keep_lengths_from_head(targets, rest_lengths);
+    placed = ffd::preserve_lengths_from_head(targets, rest_lengths);
     if (pass + 1 == kPasses) break;
     for (std::size_t i = 0; i < n; ++i) {
       const Real achieved = (placed[i] - rest[i]).dot(bend_direction);

@@ -31,15 +31,12 @@ Real wave_offset(const BodyWave& wave, Real s, Real phase);
 // Fractions of the rest polygon's arc length at each control point (0 at the head, 1 at the tail).
 std::vector<Real> arc_fractions(const Vec3List& points);
 
-// Pins point 0 and walks tailward, putting each point on the segment from its
-// (already placed) head-side neighbour toward its target at its rest distance.
-Vec3List keep_lengths_from_head(const Vec3List& targets, const std::vector<Real>& rest_lengths);
-
 // Control points of the swimming body axis for one phase. `bend_direction` is the
 // unit direction the wave displaces points in (lateral or dorsoventral);
 // `body_length` scales the amplitudes. With preserve_length the displacement along
 // bend_direction still follows the wave (a few correction passes), while the points
-// draw in along the body so every control-point distance equals its rest value.
+// draw in along the body so every control-point distance equals its rest value
+// (ffd::preserve_lengths_from_head, the seed's distance-keeping pass from the head).
 Vec3List body_axis(const Vec3List& rest, const Vec3& bend_direction, Real body_length, const BodyWave& wave,
                    Real phase);
 
