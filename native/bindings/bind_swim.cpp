@@ -14,6 +14,10 @@
 
 namespace kodawari::bind {
 
+// Fin vertex indices are int32 (arrays.hpp names float32/float64 only).
+template <>
+inline const char* dtype_name<int>() { return "int32"; }
+
 namespace {
 
 Vec3List to_points(const py::array_t<double>& a) {
