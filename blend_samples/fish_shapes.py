@@ -210,8 +210,12 @@ def build_arrays(kind, rings=48, segments=24, fin_rows=5, midline_sag=0.0):
     return np.concatenate(verts), faces, groups, len(body)
 
 
+def body_face_count(rings=48, segments=24):
+    return (rings - 1) * segments + 2 * segments
+
+
 def build_fish(kind, name=None, head_axis="POS_X", scale=1.0, location=(0.0, 0.0, 0.0), rings=48, segments=24,
-               fin_rows=5, midline_sag=0.0, collection=None):
+               fin_rows=5, midline_sag=0.0, collection=None, materials=None):
     """A mesh object for `kind` with one vertex group per fin; returns the object."""
     verts, faces, groups, _ = build_arrays(kind, rings, segments, fin_rows, midline_sag)
     a, b, c, sign = AXES[head_axis]
@@ -222,6 +226,13 @@ def build_fish(kind, name=None, head_axis="POS_X", scale=1.0, location=(0.0, 0.0
     placed *= scale
     mesh = bpy.data.meshes.new(name or kind)
     mesh.from_pydata(placed.tolist(), [], [tuple(int(i) for i in f) for f in faces])
+    if materials:
+        for material in materials:
+            mesh.materials.append(material)
+        index = np.zeros(len(mesh.polygons), dtype=np.int32)
+        index[body_face_count(rings, segments):] = len(materials) - 1  # fins use the last material
+        mesh.polygons.foreach_set("material_index", index)
+        mesh.polygons.foreach_set("use_smooth", np.ones(len(mesh.polygons), dtype=bool))
     mesh.update()
     obj = bpy.data.objects.new(name or kind, mesh)
     obj.location = location

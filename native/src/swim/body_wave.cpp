@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "kodawari/ffd/bspline.hpp"
 #include "kodawari/ffd/lengths.hpp"
 
 namespace kodawari::swim {
@@ -46,19 +47,38 @@ Vec3List body_axis(const Vec3List& rest, const Vec3& bend_direction, Real body_l
   // The distance-keeping walk shortens the sideways offsets a little (each point is
   // pulled toward its neighbour); a few fixed-point passes aim the targets further
   // out so the achieved offsets follow the wave, which keeps the tail amplitude true.
-  std::vector<Real> aim(wanted);
-  Vec3List placed;
-  constexpr int kPasses = 8;
-  for (int pass = 0; pass < kPasses; ++pass) {
-    for (std::size_t i = 0; i < n; ++i) targets[i] = rest[i] + aim[i] * bend_direction;
-    placed = ffd::preserve_lengths_from_head(targets, rest_lengths);
-    if (pass + 1 == kPasses) break;
-    for (std::size_t i = 0; i < n; ++i) {
-      const Real achieved = (placed[i] - rest[i]).dot(bend_direction);
-      // Bounded so an unreachable wave (offset steps longer than a segment) cannot run away.
-      aim[i] = std::clamp(aim[i] + (wanted[i] - achieved), -2 * std::abs(wanted[i]) - 1e-9,
-                          2 * std::abs(wanted[i]) + 1e-9);
+  auto keep_lengths = [&](const std::vector<Real>& lengths) {
+    std::vector<Real> aim(wanted);
+    Vec3List placed;
+    constexpr int kPasses = 8;
+    for (int pass = 0; pass < kPasses; ++pass) {
+      for (std::size_t i = 0; i < n; ++i) targets[i] = rest[i] + aim[i] * bend_direction;
+      placed = ffd::preserve_lengths_from_head(targets, lengths);
+      if (pass + 1 == kPasses) break;
+      for (std::size_t i = 0; i < n; ++i) {
+        const Real achieved = (placed[i] - rest[i]).dot(bend_direction);
+        // Bounded so an unreachable wave (offset steps longer than a segment) cannot run away.
+        aim[i] = std::clamp(aim[i] + (wanted[i] - achieved), -2 * std::abs(wanted[i]) - 1e-9,
+                            2 * std::abs(wanted[i]) + 1e-9);
+      }
     }
+    return placed;
+  };
+  Vec3List placed = keep_lengths(rest_lengths);
+  if (n < 4) return placed;
+
+  // The body follows the smooth B-spline, which cuts the bent polygon's corners and
+  // so comes out shorter than at rest; scale the kept distances until the curve's
+  // own arc length is the rest one again (converges in a few passes).
+  const Real rest_curve = ffd::curve_length(ffd::CubicBSpline(rest));
+  Real scale = 1.0;
+  for (int pass = 0; pass < 4; ++pass) {
+    const Real now = ffd::curve_length(ffd::CubicBSpline(placed));
+    if (!(now > 0) || std::abs(now - rest_curve) <= 1e-9 * rest_curve) break;
+    scale *= rest_curve / now;
+    std::vector<Real> lengths(rest_lengths);
+    for (Real& l : lengths) l *= scale;
+    placed = keep_lengths(lengths);
   }
   return placed;
 }

@@ -35,8 +35,9 @@ std::vector<Real> arc_fractions(const Vec3List& points);
 // unit direction the wave displaces points in (lateral or dorsoventral);
 // `body_length` scales the amplitudes. With preserve_length the displacement along
 // bend_direction still follows the wave (a few correction passes), while the points
-// draw in along the body so every control-point distance equals its rest value
-// (ffd::preserve_lengths_from_head, the seed's distance-keeping pass from the head).
+// draw in along the body, keeping their distances (ffd::preserve_lengths_from_head,
+// the seed's distance-keeping pass from the head) scaled by the one factor that gives
+// the B-spline curve, and so the body, its rest arc length.
 Vec3List body_axis(const Vec3List& rest, const Vec3& bend_direction, Real body_length, const BodyWave& wave,
                    Real phase);
 
