@@ -109,7 +109,7 @@ void bind_swim(py::module_& m) {
       "swim_fin_axis",
       [](const py::handle& rest_points, const py::handle& tangent, const py::handle& side, const py::handle& up,
          const std::string& motion, double amplitude, double phase, double feathering, double wavelength,
-         int fixed_count) {
+         int fixed_count, bool feather_on_power) {
         auto rest = checked_array<double>(rest_points, "rest_points", -1, 3);
         if (rest.shape(0) < 2) throw py::value_error("rest_points needs at least 2 points");
         swim::RootFrame frame{unit_vector(tangent, "tangent"), unit_vector(side, "side"), unit_vector(up, "up")};
@@ -118,7 +118,8 @@ void bind_swim(py::module_& m) {
           require_finite(v, n);
         }
         if (wavelength <= 0) throw py::value_error("wavelength must be positive");
-        swim::FinWave wave{fin_motion_from(motion), amplitude, feathering, wavelength, fixed_count};
+        swim::FinWave wave{fin_motion_from(motion), amplitude, feathering, feather_on_power, wavelength,
+                           fixed_count};
         const swim::FinPose pose = swim::fin_axis(to_points(rest), frame, wave, phase);
         py::array_t<double> twist(static_cast<py::ssize_t>(pose.twist.size()));
         std::copy(pose.twist.begin(), pose.twist.end(), twist.mutable_data());
@@ -126,9 +127,21 @@ void bind_swim(py::module_& m) {
       },
       py::arg("rest_points"), py::arg("tangent"), py::arg("side"), py::arg("up"), py::arg("motion"),
       py::arg("amplitude"), py::arg("phase"), py::arg("feathering") = 0.0, py::arg("wavelength") = 1.0,
-      py::arg("fixed_count") = 3,
+      py::arg("fixed_count") = 3, py::arg("feather_on_power") = false,
       "Fin control axis for a phase: (points (m, 3), twist (m,)) in rest space; motion is FLAP, UP_DOWN, TWIST "
       "or UNDULATE.");
+
+  m.def(
+      "swim_flap_stroke_direction",
+      [](const py::handle& fin_axis, const py::handle& tangent, const py::handle& side, const py::handle& up) {
+        swim::RootFrame frame{unit_vector(tangent, "tangent"), unit_vector(side, "side"), unit_vector(up, "up")};
+        const Vec3 d = swim::flap_stroke_direction(unit_vector(fin_axis, "fin_axis"), frame);
+        py::array_t<double> out(3);
+        for (int c = 0; c < 3; ++c) out.mutable_data()[c] = d[c];
+        return out;
+      },
+      py::arg("fin_axis"), py::arg("tangent"), py::arg("side"), py::arg("up"),
+      "Unit direction a FLAP power stroke moves the fin tip in.");
 
   m.def(
       "swim_accumulate_phase",

@@ -137,6 +137,9 @@ TEST(FinAxis, FlapFeathersEdgeOnDuringRecoveryOnly) {
   EXPECT_NEAR(fin_axis(rest, frame, wave, 0.0).twist[4], 0.0, 1e-12);       // mid power stroke
   EXPECT_NEAR(fin_axis(rest, frame, wave, kPi).twist[4], kPi / 2, 1e-12);  // mid recovery
   EXPECT_EQ(fin_axis(rest, frame, wave, kPi).twist[0], 0.0);
+  wave.feather_on_power = true;  // a blade modelled edge-on rolls on the power stroke instead
+  EXPECT_NEAR(fin_axis(rest, frame, wave, 0.0).twist[4], kPi / 2, 1e-12);
+  EXPECT_NEAR(fin_axis(rest, frame, wave, kPi).twist[4], 0.0, 1e-12);
 }
 
 TEST(FinAxis, UpDownMovesTipVerticallyAndTwistRolls) {

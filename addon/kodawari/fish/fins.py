@@ -8,6 +8,7 @@ own motion further out, so root vertices move exactly with the body.
 """
 
 import numpy as np
+from mathutils import kdtree
 
 # Seed: of 5 points, the first 3 close together near the root (fixed).
 ROOT_CLUSTER = (0.0, 0.05, 0.1, 0.55, 1.0)
@@ -18,7 +19,7 @@ class FinPart:
     """One side of one fin, bound to its own axis (a group holding a left and a
     right pectoral fin becomes two parts that beat as mirror images)."""
 
-    def __init__(self, fin_index, indices, weights, rest, axis, frame, root, kn):
+    def __init__(self, fin_index, indices, weights, rest, axis, frame, root, amplitude_scale, kn):
         self.fin_index = fin_index
         self.indices = indices          # int64 (M,) vertex indices into the mesh
         self.weights = weights          # float32 (M, 1) group weight × root blend
@@ -26,7 +27,9 @@ class FinPart:
         self.axis = axis                # float64 (m, 3) rest control axis
         self.tangent, self.side, self.up = frame
         self.root = root                # float64 (3,) where the fin meets the body
+        self.amplitude_scale = amplitude_scale  # UNDULATE: fin height / base length (amplitude is per height)
         self.binding = kn.ffd_bind(axis, rest, up=_up_hint(axis, self.up, self.side))
+        self.feather_on_power, self.feather_sign = _blade_facing(rest, axis, frame, kn)
         self.out = np.empty_like(rest)
         self.shift = np.empty_like(rest)
 
@@ -35,6 +38,20 @@ def _up_hint(axis, up, side):
     direction = axis[-1] - axis[0]
     direction = direction / np.linalg.norm(direction)
     return up if abs(float(direction @ up)) < 0.9 else side
+
+
+def _blade_facing(rest, axis, frame, kn):
+    """(feather on the power stroke?, roll sign): compares the modelled blade's normal
+    (least-variance direction of its vertices) with the flap stroke direction."""
+    direction = axis[-1] - axis[0]
+    stroke = kn.swim_flap_stroke_direction(direction, *frame)
+    centred = rest.astype(np.float64) - rest.mean(axis=0)
+    normal = np.linalg.svd(centred, full_matrices=False)[2][-1]
+    facing = abs(float(normal @ stroke))
+    on_power = facing < 0.7  # modelled edge-on: roll it to face the stroke on the power stroke
+    # Roll toward the stroke direction (rotation about the fin axis, right-handed).
+    sign = 1.0 if float(np.cross(normal, stroke) @ direction) >= 0 else -1.0
+    return on_power, sign
 
 
 def _smoothstep(x):
@@ -72,6 +89,21 @@ def _outward(kind, centroid_offset, frame):
     return across / norm
 
 
+def distance_from_body(points, body_points):
+    """Each fin point's distance to the nearest body vertex (body = vertices in no fin),
+    searched among the body vertices near the fin only."""
+    lo, hi = points.min(axis=0), points.max(axis=0)
+    margin = 0.25 * float(np.linalg.norm(hi - lo)) + 1e-9
+    near = body_points[np.all((body_points >= lo - margin) & (body_points <= hi + margin), axis=1)]
+    if len(near) == 0:
+        return None
+    tree = kdtree.KDTree(len(near))
+    for i, p in enumerate(near):
+        tree.insert(p, i)
+    tree.balance()
+    return np.array([tree.find(p)[2] for p in points])
+
+
 def split_sides(kind, points, axis_point, frame):
     """Masks of the parts of a fin group: pectoral and pelvic groups holding both a
     left and a right fin split by side; other kinds stay whole."""
@@ -85,7 +117,7 @@ def split_sides(kind, points, axis_point, frame):
     return whole
 
 
-def build_parts(fin_index, fin, group_weights, verts, body_axis, up, kn):
+def build_parts(fin_index, fin, group_weights, verts, body_axis, up, kn, body_points=None):
     """FinParts of one fin setting; raises ValueError with a readable reason."""
     indices = np.flatnonzero(group_weights > 0.0)
     if len(indices) < 4:
@@ -99,11 +131,15 @@ def build_parts(fin_index, fin, group_weights, verts, body_axis, up, kn):
         part_indices = indices[mask]
         centroid = points.mean(axis=0)
         frame, axis_point = body_frame_at(centroid, body_axis, up)
-        outward = _outward(fin.kind, centroid - axis_point, frame)
-        reach = (points - centroid) @ outward
+        # How far out each vertex is: its distance from the body where the fin has body
+        # vertices around it (so the root row, on the body, is exactly 0), else its
+        # reach along the fin kind's outward direction.
+        reach = distance_from_body(points, body_points) if body_points is not None and len(body_points) else None
+        if reach is None:
+            reach = (points - centroid) @ _outward(fin.kind, centroid - axis_point, frame)
         lo, hi = float(reach.min()), float(reach.max())
         if hi - lo < 1e-6:
-            raise ValueError(f"vertex group '{fin.vertex_group}' is flat along the fin's direction")
+            raise ValueError(f"vertex group '{fin.vertex_group}' does not stand out from the body")
         r = (reach - lo) / (hi - lo)  # 0 at the root, 1 at the fin's outer edge
         root_set = points[r <= 0.1]
         tip_set = points[r >= 0.9]
@@ -116,7 +152,9 @@ def build_parts(fin_index, fin, group_weights, verts, body_axis, up, kn):
             middle = centroid - (centroid @ frame[0]) * frame[0]
             stations = np.linspace(front, back, UNDULATE_POINTS) + centroid @ frame[0]
             axis = middle[None, :] + stations[:, None] * frame[0][None, :]
+            amplitude_scale = (hi - lo) / (back - front)
         else:
+            amplitude_scale = 1.0
             tip = tip_set.mean(axis=0)
             if np.linalg.norm(tip - root) < 1e-6:
                 raise ValueError(f"vertex group '{fin.vertex_group}' has no length from root to tip")
@@ -125,5 +163,5 @@ def build_parts(fin_index, fin, group_weights, verts, body_axis, up, kn):
         weights = (group_weights[part_indices] * blend).astype(np.float32)[:, None]
         rest = np.ascontiguousarray(verts[part_indices], dtype=np.float32)
         parts.append(FinPart(fin_index, part_indices, weights, rest, np.ascontiguousarray(axis), frame,
-                             root, kn))
+                             root, amplitude_scale, kn))
     return parts

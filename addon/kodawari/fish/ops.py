@@ -4,6 +4,7 @@ import os
 import types
 
 import bpy
+import numpy as np
 from bpy.props import EnumProperty, FloatProperty, IntProperty, StringProperty
 
 from .. import bulk, fcurves, native
@@ -140,7 +141,11 @@ def _check_fin(obj, group_name, kind):
     trial = types.SimpleNamespace(vertex_group=group_name, kind=kind, motion=motion, root_blend=0.35)
     try:
         rig = runtime.get_rig(obj)
-        fin_setup.build_parts(0, trial, weights, rig.rest, rig.axis_rest, rig.up, native.module())
+        in_fin = weights > 0
+        for fin in settings.fins:
+            in_fin |= bulk.vertex_group_weights(obj, fin.vertex_group) > 0
+        body_points = rig.rest[~in_fin].astype(np.float64)
+        fin_setup.build_parts(0, trial, weights, rig.rest, rig.axis_rest, rig.up, native.module(), body_points)
     except ValueError as exc:
         return f"Cannot bind fin '{group_name}': {exc}", None
     return None, weights

@@ -1,7 +1,7 @@
 """Swimming modes of the fish document (SEEDS §1) with numbers from the literature.
 
 Body values are fractions of body length L; fin amplitudes are radians for FLAP,
-UP_DOWN and TWIST and fractions of the fin's length for UNDULATE.
+UP_DOWN and TWIST and, for UNDULATE, the sideways excursion as a fraction of the fin's height.
 Sources: SEEDS §1 literature notes (Bainbridge 1958; tail peak ≈ 0.1 L at cruise,
 maximum ≈ L/5; Strouhal 0.25-0.3 for carangiform swimmers) and the issue's preset list.
 """
@@ -62,13 +62,13 @@ _DEG = math.pi / 180.0
 
 # (preset, kind) -> (amplitude, phase lag radians, feathering radians); unlisted → small beat.
 FIN_BY_PRESET = {
-    ("ANGUILLIFORM", "DORSAL"): (0.05, 0.0, 0.0),
-    ("ANGUILLIFORM", "ANAL"): (0.05, 0.0, 0.0),
+    ("ANGUILLIFORM", "DORSAL"): (0.2, 0.0, 0.0),
+    ("ANGUILLIFORM", "ANAL"): (0.2, 0.0, 0.0),
     ("ANGUILLIFORM", "CAUDAL"): (0.0, 0.0, 0.0),
     ("CARANGIFORM", "PECTORAL"): (15 * _DEG, 90 * _DEG, 30 * _DEG),
     ("CARANGIFORM", "CAUDAL"): (0.0, 0.0, 0.0),
-    ("CARANGIFORM", "DORSAL"): (0.03, 0.0, 0.0),
-    ("CARANGIFORM", "ANAL"): (0.03, 0.0, 0.0),
+    ("CARANGIFORM", "DORSAL"): (0.1, 0.0, 0.0),
+    ("CARANGIFORM", "ANAL"): (0.1, 0.0, 0.0),
     ("THUNNIFORM", "PECTORAL"): (5 * _DEG, 90 * _DEG, 0.0),
     ("THUNNIFORM", "CAUDAL"): (10 * _DEG, 90 * _DEG, 0.0),
     ("THUNNIFORM", "DORSAL"): (0.0, 0.0, 0.0),
@@ -77,14 +77,14 @@ FIN_BY_PRESET = {
     ("OSTRACIIFORM", "PECTORAL"): (35 * _DEG, 90 * _DEG, 60 * _DEG),
     ("OSTRACIIFORM", "DORSAL"): (0.0, 0.0, 0.0),
     ("OSTRACIIFORM", "ANAL"): (0.0, 0.0, 0.0),
-    ("BALISTIFORM", "DORSAL"): (0.12, 0.0, 0.0),
-    ("BALISTIFORM", "ANAL"): (0.12, math.pi, 0.0),
+    ("BALISTIFORM", "DORSAL"): (0.6, 0.0, 0.0),
+    ("BALISTIFORM", "ANAL"): (0.6, math.pi, 0.0),
     ("BALISTIFORM", "PECTORAL"): (15 * _DEG, 90 * _DEG, 30 * _DEG),
     ("BALISTIFORM", "CAUDAL"): (5 * _DEG, 0.0, 0.0),
     ("LABRIFORM", "PECTORAL"): (45 * _DEG, 0.0, 80 * _DEG),
     ("LABRIFORM", "CAUDAL"): (5 * _DEG, 0.0, 0.0),
-    ("LABRIFORM", "DORSAL"): (0.02, 0.0, 0.0),
-    ("LABRIFORM", "ANAL"): (0.02, 0.0, 0.0),
+    ("LABRIFORM", "DORSAL"): (0.15, 0.0, 0.0),
+    ("LABRIFORM", "ANAL"): (0.15, 0.0, 0.0),
     ("CETACEAN", "PECTORAL"): (8 * _DEG, 90 * _DEG, 0.0),
     ("CETACEAN", "CAUDAL"): (0.0, 0.0, 0.0),
     ("CETACEAN", "DORSAL"): (0.0, 0.0, 0.0),
@@ -94,7 +94,7 @@ FIN_BY_PRESET = {
 def fin_defaults(preset, kind):
     """(motion, amplitude, phase_lag, feathering) of a new fin of `kind` under `preset`."""
     motion = FIN_MOTION_BY_KIND[kind]
-    amplitude, lag, feathering = FIN_BY_PRESET.get((preset, kind), (10 * _DEG if motion != "UNDULATE" else 0.05,
+    amplitude, lag, feathering = FIN_BY_PRESET.get((preset, kind), (10 * _DEG if motion != "UNDULATE" else 0.3,
                                                                      0.0, 0.0))
     return motion, amplitude, lag, feathering
 

@@ -66,7 +66,7 @@ class KodawariSwimFin(bpy.types.PropertyGroup):
     enabled: BoolProperty(name="Enabled", default=True, update=_refresh)
     amplitude: FloatProperty(
         name="Amplitude",
-        description="Peak angle (radians) for Flap, Up-Down and Twist; fraction of the fin's length for Undulate",
+        description="Peak angle (radians) for Flap, Up-Down and Twist; sideways excursion as a fraction of the fin's height for Undulate",
         default=0.3, min=0.0, soft_max=1.5, update=_refresh,
     )
     frequency_ratio: FloatProperty(

@@ -31,7 +31,7 @@ def binding_signature(obj, settings):
 
 
 class SwimRig:
-    def __init__(self, obj, settings, group_weights=None):
+    def __init__(self, obj, settings):
         kn = native.module()
         self.kn = kn
         self.signature = binding_signature(obj, settings)
@@ -45,12 +45,16 @@ class SwimRig:
         self.positions = np.empty_like(self.rest)
         self.axis = self.axis_rest.copy()
         self.parts = []
+        weights = {f.vertex_group: bulk.vertex_group_weights(obj, f.vertex_group)
+                   for f in settings.fins if f.enabled}
+        in_fin = np.zeros(self.count, dtype=bool)
+        for w in weights.values():
+            in_fin |= w > 0
+        body_points = self.rest[~in_fin].astype(np.float64)
         for index, fin in enumerate(settings.fins):
-            if not fin.enabled:
-                continue
-            weights = group_weights(fin.vertex_group) if group_weights else bulk.vertex_group_weights(
-                obj, fin.vertex_group)
-            self.parts.extend(fin_setup.build_parts(index, fin, weights, self.rest, self.axis_rest, self.up, kn))
+            if fin.enabled:
+                self.parts.extend(fin_setup.build_parts(index, fin, weights[fin.vertex_group], self.rest,
+                                                        self.axis_rest, self.up, kn, body_points))
         # Four probe points per fin part (root and one step along its tangent, side, up):
         # deformed with the body they give the body's rotation at the root.
         arm = PROBE_SCALE * self.body_length
@@ -107,8 +111,10 @@ class SwimRig:
                 continue
             fin_phase = phase * fin.frequency_ratio - fin.phase_lag
             points, twist = kn.swim_fin_axis(
-                part.axis, part.tangent, part.side, part.up, fin.motion, fin.amplitude, fin_phase,
-                feathering=fin.feathering, wavelength=fin.wavelength, fixed_count=3)
+                part.axis, part.tangent, part.side, part.up, fin.motion, fin.amplitude * part.amplitude_scale,
+                fin_phase,
+                feathering=fin.feathering * part.feather_sign, wavelength=fin.wavelength, fixed_count=3,
+                feather_on_power=part.feather_on_power)
             part.binding.deform(points, part.out, twist=twist)
             # The fin's own motion (rest space), turned with the body at its root and
             # faded in from the root: root vertices keep the body's position exactly.

@@ -22,6 +22,12 @@ Vec3 cross_or(const Vec3& a, const Vec3& b, const Vec3& fallback) {
 
 }  // namespace
 
+Vec3 flap_stroke_direction(const Vec3& fin_axis, const RootFrame& frame) {
+  const Vec3 axis = fin_axis.normalized();
+  const Vec3 k = cross_or(axis, frame.tangent, frame.up);
+  return k.cross(axis).normalized();
+}
+
 FinPose fin_axis(const Vec3List& rest, const RootFrame& frame, const FinWave& wave, Real phase) {
   FinPose pose{rest, std::vector<Real>(rest.size(), Real(0))};
   const std::size_t m = rest.size();
@@ -52,9 +58,11 @@ FinPose fin_axis(const Vec3List& rest, const RootFrame& frame, const FinWave& wa
       // Tip moves fore/aft; a fin lying along the body (caudal) moves sideways.
       const Vec3 k = cross_or(axis, frame.tangent, frame.up);
       rotation = axis_rotation(k, wave.amplitude * std::sin(phase));
-      // Feathering: blade across the motion on the power stroke (tip moving tailward,
-      // cos φ > 0), rolled edge-on by `feathering` mid-recovery.
-      roll = wave.feathering * Real(0.5) * (Real(1) - std::cos(phase));
+      // Feathering (SEEDS §1): blade across the motion on the power stroke (tip moving
+      // tailward, cos φ > 0), nearly edge-on on the recovery. The roll sits on whichever
+      // stroke the modelled blade does not already match.
+      const Real toward = wave.feather_on_power ? Real(1) + std::cos(phase) : Real(1) - std::cos(phase);
+      roll = wave.feathering * Real(0.5) * toward;
       break;
     }
     case FinMotion::UpDown: {

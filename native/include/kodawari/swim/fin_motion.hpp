@@ -13,11 +13,17 @@ enum class FinMotion { Flap, UpDown, Twist, Undulate };
 
 struct FinWave {
   FinMotion motion = FinMotion::Flap;
-  Real amplitude = 0.5;    // radians for FLAP/UP_DOWN/TWIST; fraction of fin length for UNDULATE
-  Real feathering = 0.0;   // FLAP only: blade roll (radians) reached mid-recovery, 0 mid-power-stroke
+  Real amplitude = 0.5;    // radians for FLAP/UP_DOWN/TWIST; fraction of the axis length for UNDULATE
+  Real feathering = 0.0;   // FLAP only: blade roll (radians) between the power and recovery strokes
+  bool feather_on_power = false;  // true: roll mid-power-stroke (blade modelled edge-on to the stroke);
+                                  // false: roll mid-recovery (blade modelled across the stroke)
   Real wavelength = 1.0;   // UNDULATE only: in fin-base lengths
   int fixed_count = 3;     // leading control points that never move (seed: 3 of 5)
 };
+
+// Unit direction the FLAP stroke moves the fin tip in at the power stroke (tailward
+// for a fin sticking out of the body), for the caller to compare with the blade.
+Vec3 flap_stroke_direction(const Vec3& fin_axis, const struct RootFrame& frame);
 
 // The body's frame at the fin root: unit tailward tangent, side and up (right-handed
 // or not, only used as directions).
