@@ -89,11 +89,11 @@ def build_arrays(kind, rings=48, segments=24, fin_rows=5, midline_sag=0.0):
     for r in range(rings - 1):
         for k in range(segments):
             a, b = r * segments + k, r * segments + (k + 1) % segments
-            faces.append((a, b, b + segments, a + segments))
+            faces.append((a, a + segments, b + segments, b))  # outward normals
     for k in range(segments):
-        faces.append((snout, (k + 1) % segments, k))
+        faces.append((snout, k, (k + 1) % segments))
         last = (rings - 1) * segments
-        faces.append((tail, last + k, last + (k + 1) % segments))
+        faces.append((tail, last + (k + 1) % segments, last + k))
     count = snout + 2
     groups = {}
 

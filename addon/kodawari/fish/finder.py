@@ -29,13 +29,17 @@ def _thickness(mesh, verts, body_length):
     reach = 0.5 * body_length
     thickness = np.zeros(len(verts))
     for i, (v, n) in enumerate(zip(verts, normals)):
-        direction = Vector((-float(n[0]), -float(n[1]), -float(n[2])))
-        if direction.length == 0:
+        inward = Vector((-float(n[0]), -float(n[1]), -float(n[2])))
+        if inward.length == 0:
             continue
-        origin = Vector((float(v[0]), float(v[1]), float(v[2]))) + direction * eps
-        hit = tree.ray_cast(origin, direction, reach)
-        # An open plate (no far side within reach) counts as thin.
-        thickness[i] = hit[3] + eps if hit[0] is not None else 0.0
+        point = Vector((float(v[0]), float(v[1]), float(v[2])))
+        # Inward first; a mesh with flipped normals finds its far side the other way.
+        # An open plate (no far side within reach either way) counts as thin.
+        for direction in (inward, -inward):
+            hit = tree.ray_cast(point + direction * eps, direction, reach)
+            if hit[0] is not None:
+                thickness[i] = hit[3] + eps
+                break
     return thickness
 
 

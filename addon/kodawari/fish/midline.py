@@ -93,4 +93,5 @@ def midline_points(verts, head_axis, count, slices=None):
     arc = np.concatenate([[0.0], np.cumsum(seg)])
     targets = np.linspace(0.0, arc[-1], count)
     points = np.stack([np.interp(targets, arc, line[:, c]) for c in range(3)], axis=1)
-    return np.ascontiguousarray(points), float(arc[-1])
+    # Body length: snout to tail tip along the head axis (what "L" means in the literature).
+    return np.ascontiguousarray(points), float(length)
