@@ -39,9 +39,11 @@ class KODAWARI_OT_swim_add(bpy.types.Operator):
 
     def execute(self, context):
         obj = _active_mesh(context)
-        error = validate.swim_target(obj) or validate.frequency(self.frequency)
-        if error is None and (obj.kodawari_swim.enabled or obj.kodawari_swim.baked != "NONE"):
+        if obj is not None and obj.type == "MESH" and (obj.kodawari_swim.enabled or obj.kodawari_swim.baked != "NONE"
+                                                        or runtime.swim_key_block(obj) is not None):
             error = f"'{obj.name}' already swims: tune it in the Modifier tab, or remove it first"
+        else:
+            error = validate.swim_target(obj) or validate.frequency(self.frequency)
         if error:
             self.report({"ERROR"}, error)
             return {"CANCELLED"}
