@@ -14,10 +14,6 @@
 
 namespace kodawari::bind {
 
-// Fin vertex indices are int32 (arrays.hpp names float32/float64 only).
-template <>
-inline const char* dtype_name<int>() { return "int32"; }
-
 namespace {
 
 Vec3List to_points(const py::array_t<double>& a) {
@@ -166,31 +162,6 @@ void bind_swim(py::module_& m) {
       py::arg("mode"), py::arg("body_length"), py::arg("frequency"), py::arg("amplitude"), py::arg("strouhal"),
       "Swimming speed (length units per second): BAINBRIDGE V = L(3f - 4)/4, STROUHAL U = f·A/St with "
       "A = 2·amplitude·L, NONE 0.");
-
-  m.def(
-      "swim_blend",
-      [](const py::handle& out, const py::handle& indices, const py::handle& positions, const py::handle& weights) {
-        auto o = checked_output<float>(out, "out", -1, 3);
-        auto idx = checked_array<int>(indices, "indices", -1, 0);
-        const py::ssize_t count = idx.shape(0);
-        auto p = checked_array<float>(positions, "positions", count, 3);
-        auto w = checked_array<float>(weights, "weights", count, 0);
-        const int* id = idx.data();
-        const py::ssize_t rows = o.shape(0);
-        for (py::ssize_t k = 0; k < count; ++k) {
-          if (id[k] < 0 || id[k] >= rows) throw py::value_error("indices must lie in [0, len(out))");
-        }
-        float* od = o.mutable_data();
-        const float* pd = p.data();
-        const float* wd = w.data();
-        py::gil_scoped_release release;
-        for (py::ssize_t k = 0; k < count; ++k) {
-          float* row = od + 3 * static_cast<py::ssize_t>(id[k]);
-          for (int c = 0; c < 3; ++c) row[c] += wd[k] * (pd[3 * k + c] - row[c]);
-        }
-      },
-      py::arg("out"), py::arg("indices"), py::arg("positions"), py::arg("weights"),
-      "In place: out[indices] += weights * (positions - out[indices]) (fin positions over the body's).");
 }
 
 }  // namespace kodawari::bind
