@@ -207,3 +207,15 @@ def test_fin_finder_makes_vertex_groups_and_fins(empty_scene):
         overlap = len(found[name] & truth[name]) / len(found[name] | truth[name])
         assert overlap > 0.5, (name, overlap)
     assert {f.kind for f in obj.kodawari_swim.fins} >= {"DORSAL", "PECTORAL", "CAUDAL"}
+
+
+def test_shape_key_memory_write_matches_what_blender_reads(empty_scene):
+    from kodawari import bulk
+
+    obj = make_fish("tuna")
+    add_swim(obj, head_axis="POS_X")
+    block = obj.data.shape_keys.key_blocks[SHAPE_KEY]
+    positions = rest(obj) + np.random.default_rng(1).normal(size=rest(obj).shape).astype(np.float32)
+    assert bulk.write_shape_key_positions(block, positions)  # the fast path is taken here
+    assert np.array_equal(live(obj), positions)
+    assert np.abs(evaluated(obj) - positions).max() < 1e-6

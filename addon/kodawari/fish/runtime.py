@@ -127,7 +127,7 @@ def evaluate(obj, scene, frame=None):
     positions = rig.evaluate(settings, phase)
     block = swim_key_block(obj)
     if block is not None:
-        bulk.set_shape_key_positions(block, positions)
+        bulk.write_shape_key_positions(block, positions)
     if settings.speed_mode != "NONE":
         apply_travel(obj, rig, distance)
     return positions
