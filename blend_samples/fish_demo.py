@@ -1,11 +1,10 @@
 """Fish swim demo: six procedural fish, one per swimming mode, built and set up
 with the add-on's own operators; saves out/fish.blend and renders
-out/fish_sheet.png (columns: frames across one tail beat; top block seen from
-above, bottom block from the side). Runs in Blender 3.4 via tools/run_demo.sh.
-
-Layout of each block (left to right, top to bottom): tuna (thunniform),
-eel (anguilliform), boxfish (ostraciiform); filefish (balistiform),
-pufferfish (labriform), dolphin (cetacean).
+out/fish_sheet.png, a contact sheet with one row per fish — tuna (thunniform),
+eel (anguilliform), boxfish (ostraciiform), filefish (balistiform), pufferfish
+(labriform), dolphin (cetacean) — and eight columns: four frames a quarter tail
+beat apart seen from above, then the same four frames seen from the side.
+Runs in Blender 3.4 via tools/run_demo.sh.
 """
 
 import math
@@ -19,7 +18,7 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import fish_shapes  # noqa: E402
 
 OUT = os.environ.get("KODAWARI_OUT", os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "out"))
-TILE = (400, 260)
+TILE = (240, 136)
 FRAMES = (1, 4, 7, 10)   # a quarter beat apart at 2 Hz, 24 fps
 
 FISH = (
@@ -53,7 +52,7 @@ def build_scene():
     for i, (kind, preset, body_colour, fin_colour, frequency) in enumerate(FISH):
         col, row = i % 3, i // 3
         # Diagonal rows: separated both from above (y) and from the side (z).
-        location = (col * 1.35 - 1.35, -row * 0.9, -row * 0.75)
+        location = (col * 1.3 - 1.3, -row * 0.75, -row * 0.6)
         obj = fish_shapes.build_fish(kind, location=location,
                                      materials=(material(kind + "_body", body_colour),
                                                 material(kind + "_fins", fin_colour)))
@@ -67,12 +66,11 @@ def build_scene():
     return scene, fish
 
 
-def add_view(scene, name, location, rotation, scale):
+def add_view(scene, name, rotation, scale):
     cam_data = bpy.data.cameras.new(name)
     cam_data.type = "ORTHO"
     cam_data.ortho_scale = scale
     cam = bpy.data.objects.new(name, cam_data)
-    cam.location = location
     cam.rotation_euler = rotation
     scene.collection.objects.link(cam)
     return cam
@@ -88,16 +86,23 @@ def setup_render(scene):
     scene.render.image_settings.file_format = "PNG"
     world = bpy.data.worlds.new("water")
     world.use_nodes = True
-    world.node_tree.nodes["Background"].inputs["Color"].default_value = (0.55, 0.7, 0.8, 1.0)
-    world.node_tree.nodes["Background"].inputs["Strength"].default_value = 0.9
+    world.node_tree.nodes["Background"].inputs["Color"].default_value = (0.25, 0.42, 0.55, 1.0)
+    world.node_tree.nodes["Background"].inputs["Strength"].default_value = 0.6
     scene.world = world
     sun = bpy.data.objects.new("sun", bpy.data.lights.new("sun", "SUN"))
-    sun.data.energy = 3.0
-    sun.rotation_euler = (math.radians(35), math.radians(-20), math.radians(20))
+    sun.data.energy = 4.0
+    sun.rotation_euler = (math.radians(30), math.radians(-25), math.radians(15))
     scene.collection.objects.link(sun)
-    top = add_view(scene, "top", (0.0, -0.45, 6.0), (0.0, 0.0, 0.0), 4.3)
-    side = add_view(scene, "side", (0.0, -8.0, -0.38), (math.radians(90), 0.0, 0.0), 4.3)
+    top = add_view(scene, "top", (0.0, 0.0, 0.0), 1.45)
+    side = add_view(scene, "side", (math.radians(90), 0.0, 0.0), 1.45)
     return top, side
+
+
+def aim(top, side, obj):
+    """Frame one fish: the top camera above it, the side camera beside it."""
+    x, y, z = obj.location
+    top.location = (x - 0.05, y, z + 5.0)
+    side.location = (x - 0.05, y - 5.0, z)
 
 
 def render_tile(scene, camera, frame, path):
@@ -118,15 +123,23 @@ def main():
     top, side = setup_render(scene)
     bpy.ops.wm.save_as_mainfile(filepath=os.path.join(OUT, "fish.blend"))
     width, height = TILE
-    gap = 4
-    sheet = np.ones(((height + gap) * 2, (width + gap) * len(FRAMES), 4), dtype=np.float32)
-    for r, camera in enumerate((top, side)):
-        for c, frame in enumerate(FRAMES):
-            tile = render_tile(scene, camera, frame, os.path.join(OUT, f"_tile_{r}_{c}.png"))
-            # Image rows run bottom-up: the first block (top view) goes to the top of the sheet.
-            y0 = sheet.shape[0] - (r + 1) * (height + gap)
-            x0 = c * (width + gap)
-            sheet[y0:y0 + height, x0:x0 + width] = tile
+    gap = 3
+    columns = 2 * len(FRAMES)
+    sheet = np.ones(((height + gap) * len(fish), (width + gap) * columns + gap * 3, 4), dtype=np.float32)
+    for row, obj in enumerate(fish):
+        for other in fish:
+            other.hide_render = other is not obj
+        aim(top, side, obj)
+        for view, camera in enumerate((top, side)):
+            for c, frame in enumerate(FRAMES):
+                tile = render_tile(scene, camera, frame, os.path.join(OUT, f"_tile_{row}_{view}_{c}.png"))
+                # Image rows run bottom-up: the first fish goes to the top of the sheet.
+                y0 = sheet.shape[0] - (row + 1) * (height + gap)
+                x0 = (view * len(FRAMES) + c) * (width + gap) + view * gap * 3
+                sheet[y0:y0 + height, x0:x0 + width] = tile
+    for obj in fish:
+        obj.hide_render = False
+    bpy.ops.wm.save_as_mainfile(filepath=os.path.join(OUT, "fish.blend"))
     image = bpy.data.images.new("fish_sheet", sheet.shape[1], sheet.shape[0], alpha=True)
     image.pixels.foreach_set(sheet.reshape(-1))
     image.filepath_raw = os.path.join(OUT, "fish_sheet.png")

@@ -219,3 +219,33 @@ def test_shape_key_memory_write_matches_what_blender_reads(empty_scene):
     assert bulk.write_shape_key_positions(block, positions)  # the fast path is taken here
     assert np.array_equal(live(obj), positions)
     assert np.abs(evaluated(obj) - positions).max() < 1e-6
+
+
+def test_spine_bends_into_the_turns_of_a_path(empty_scene):
+    set_fps(24)
+    bpy.ops.curve.primitive_bezier_circle_add(radius=2.0)
+    circle = bpy.context.active_object
+    obj = make_fish("eel")
+    settings = add_swim(obj, head_axis="POS_X", preset="ANGUILLIFORM", frequency=3.0)
+    settings.amplitude = settings.amplitude_head = 0.0  # no wave: only the path's bend
+    settings.path_start = 0.25
+    follow = obj.constraints.new("FOLLOW_PATH")
+    follow.target = circle
+    settings.speed_mode = "BAINBRIDGE"
+    bpy.context.scene.frame_set(12)
+    from kodawari.fish import runtime
+
+    axis = runtime.get_rig(obj).axis
+    middle = axis[len(axis) // 2]
+    # Head and tail bend toward the circle's centre by the sagitta d² / 2R (R = 2).
+    to_centre = np.array(obj.matrix_world.inverted() @ circle.matrix_world.translation) - middle
+    to_centre[0] = 0.0
+    to_centre /= np.linalg.norm(to_centre)
+    for end in (axis[0], axis[-1]):
+        d = abs(end[0] - middle[0])
+        assert (end - middle) @ to_centre == pytest.approx(d ** 2 / (2 * 2.0), rel=0.2)
+    # The whole fish lies along the circle.
+    world = np.array(obj.matrix_world)
+    positions = evaluated(obj) @ world[:3, :3].T + world[:3, 3]
+    radii = np.linalg.norm(positions[:, :2] - np.array(circle.location[:2]), axis=1)
+    assert np.abs(radii - 2.0).max() < 0.1

@@ -55,7 +55,7 @@ class Baker:
         self.handle = None
         self.keys = []          # SHAPE_KEYS: positions per frame, made into keys at the end
         self.travel = []        # speed mode: the object's travel per frame
-        self.follow = runtime._follow_path(obj) if obj.kodawari_swim.speed_mode != "NONE" else None
+        self.follow = runtime.path.follow_path(obj) if obj.kodawari_swim.speed_mode != "NONE" else None
 
     @property
     def done(self):

@@ -65,6 +65,8 @@ class KODAWARI_PT_swim(bpy.types.Panel):
         row.prop(settings, "speed_mode")
         if settings.speed_mode == "STROUHAL":
             row.prop(settings, "strouhal")
+        if settings.speed_mode != "NONE" and any(c.type == "FOLLOW_PATH" for c in obj.constraints):
+            layout.prop(settings, "path_start")
 
         layout.label(text="Fins")
         row = layout.row()

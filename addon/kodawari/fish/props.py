@@ -139,6 +139,9 @@ class KodawariSwimSettings(bpy.types.PropertyGroup):
     )
     strouhal: FloatProperty(name="Strouhal", description="Strouhal number St = f A / U (0.2-0.4 in nature)",
                             default=0.3, min=0.05, max=2.0, update=_refresh)
+    path_start: FloatProperty(name="Path Start", description="Along a Follow Path curve: where the swim starts "
+                              "(fraction of the path)", default=0.0, min=0.0, max=1.0, subtype="FACTOR",
+                              update=_refresh)
     fins: CollectionProperty(type=KodawariSwimFin)
     fin_index: IntProperty(name="Active Fin", default=0)
     show_axis: BoolProperty(name="Show Axis", description="Draw the control axis in the viewport", default=True)

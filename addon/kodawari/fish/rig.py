@@ -71,9 +71,10 @@ class SwimRig:
     def bend_direction(self, settings):
         return self.up if settings.bend == "DORSOVENTRAL" else self.side
 
-    def body_axis(self, settings, phase):
+    def body_axis(self, settings, phase, rest_axis=None):
         return self.kn.swim_body_axis(
-            self.axis_rest, self.bend_direction(settings), self.body_length, phase,
+            self.axis_rest if rest_axis is None else rest_axis, self.bend_direction(settings), self.body_length,
+            phase,
             wavelength=settings.wavelength, amplitude=settings.amplitude,
             amplitude_head=settings.amplitude_head, envelope_start=settings.envelope_start,
             envelope_power=settings.envelope_power, phase_offset=settings.phase_offset,
@@ -96,10 +97,11 @@ class SwimRig:
             rotations.append(r)
         return rotations
 
-    def evaluate(self, settings, phase):
-        """Deformed positions float32 (N, 3) for the phase (radians, accumulated)."""
+    def evaluate(self, settings, phase, rest_axis=None):
+        """Deformed positions float32 (N, 3) for the phase (radians, accumulated); `rest_axis`
+        replaces the straight rest axis (a spine bent along a path) before the wave."""
         kn = self.kn
-        self.axis = self.body_axis(settings, phase)
+        self.axis = self.body_axis(settings, phase, rest_axis)
         self.binding.deform(self.axis, self.positions)
         if not self.parts:
             return self.positions

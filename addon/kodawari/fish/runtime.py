@@ -14,6 +14,7 @@ import mathutils
 from bpy.app.handlers import persistent
 
 from .. import bulk
+from . import path
 from . import rig as rig_module
 from . import timing
 
@@ -75,45 +76,9 @@ def travel_direction(obj, rig):
     return obj.matrix_basis.to_3x3() @ mathutils.Vector(rig.head)
 
 
-def _follow_path(obj):
-    for constraint in obj.constraints:
-        if (constraint.type == "FOLLOW_PATH" and constraint.target is not None
-                and constraint.target.type == "CURVE" and not constraint.mute):
-            return constraint
-    return None
-
-
-def _path_length(curve_obj):
-    """World-space length of a curve object's first spline (evaluated polyline)."""
-    import numpy as np
-
-    depsgraph = bpy.context.evaluated_depsgraph_get()
-    evaluated = curve_obj.evaluated_get(depsgraph)
-    mesh = evaluated.to_mesh()
-    try:
-        points = np.empty((len(mesh.vertices), 3), dtype=np.float64)
-        mesh.vertices.foreach_get("co", points.reshape(-1))
-    finally:
-        evaluated.to_mesh_clear()
-    if len(points) < 2:
-        return 0.0
-    world = np.array(curve_obj.matrix_world)
-    points = points @ world[:3, :3].T + world[:3, 3]
-    return float(np.linalg.norm(np.diff(points, axis=0), axis=1).sum())
-
-
 def apply_travel(obj, rig, distance):
-    """Advance the object along its head direction, or along its Follow Path curve."""
-    settings = obj.kodawari_swim
-    follow = _follow_path(obj)
-    if follow is not None:
-        length = _path_length(follow.target)
-        if length > 0:
-            scale = obj.matrix_world.to_3x3().to_scale()[0]
-            follow.use_fixed_location = True
-            follow.offset_factor = min(1.0, max(0.0, distance * scale / length))
-        return
-    rest = mathutils.Vector(settings.rest_delta_location)
+    """Advance the object along its head direction; returns nothing (see evaluate for paths)."""
+    rest = mathutils.Vector(obj.kodawari_swim.rest_delta_location)
     obj.delta_location = rest + travel_direction(obj, rig) * distance
 
 
@@ -124,12 +89,22 @@ def evaluate(obj, scene, frame=None):
     if frame is None:
         frame = scene.frame_current + scene.frame_subframe
     phase, distance = timing.phase_and_distance(obj, settings, scene, frame, rig.body_length)
-    positions = rig.evaluate(settings, phase)
+    rest_axis = None
+    follow = path.follow_path(obj) if settings.speed_mode != "NONE" else None
+    if follow is not None:
+        # Along a curve: place the fish on it and bend the spine into its turns.
+        scale = float(obj.matrix_world.to_3x3().to_scale()[0])
+        points, arc = path.polyline(follow.target)
+        start = float(settings.path_start) * arc[-1]
+        path.place(obj, follow, settings.head_axis, start + distance * scale, points, arc)
+        rest_axis = path.bent_rest_axis(rig.axis_rest, rig.head, rig.up, rig.side, scale,
+                                        start + distance * scale, points, arc)
+    elif settings.speed_mode != "NONE":
+        apply_travel(obj, rig, distance)
+    positions = rig.evaluate(settings, phase, rest_axis)
     block = swim_key_block(obj)
     if block is not None:
         bulk.write_shape_key_positions(block, positions)
-    if settings.speed_mode != "NONE":
-        apply_travel(obj, rig, distance)
     return positions
 
 
