@@ -127,8 +127,7 @@ void bind_ffd(py::module_& m) {
         const std::vector<Real> twist_values = to_twist(twist, points.size());
         const std::optional<Vec3> up_hint = to_up(up);
         if (samples < 2) throw py::value_error("samples must be >= 2");
-        const ffd::CubicBSpline curve(points);
-        const ffd::FrameList frames = ffd::axis_frames(curve, twist_values, up_hint, samples);
+        const ffd::FrameList frames = ffd::axis_frames(points, twist_values, up_hint, samples);
         py::array_t<double> out({static_cast<py::ssize_t>(samples), py::ssize_t(4), py::ssize_t(3)});
         double* data = out.mutable_data();
         for (std::size_t i = 0; i < frames.size(); ++i) {
@@ -165,24 +164,26 @@ void bind_ffd(py::module_& m) {
 
   m.def(
       "preserve_lengths",
-      [](const py::handle& points, const py::handle& rest_lengths, long moved_index) {
+      [](const py::handle& points, const py::handle& rest_lengths, long moved_index, std::optional<double> arc_length) {
         const Vec3List p = to_points(points, "points");
         const auto rest = checked_array<double>(rest_lengths, "rest_lengths", -1, 0);
         const std::vector<Real> lengths(rest.data(), rest.data() + rest.shape(0));
-        return points_array(ffd::preserve_lengths(p, lengths, moved_index));
+        return points_array(ffd::preserve_lengths(p, lengths, moved_index, arc_length));
       },
-      py::arg("points"), py::arg("rest_lengths"), py::arg("moved_index"),
-      "The seed's distance-keeping pass: keep points[moved_index], restore every rest length toward both ends.");
+      py::arg("points"), py::arg("rest_lengths"), py::arg("moved_index"), py::arg("arc_length") = py::none(),
+      "The seed's distance-keeping pass: keep points[moved_index], restore every rest length toward both ends.\n"
+      "With arc_length, scale all lengths by one factor until the curve's arc length equals it.");
 
   m.def(
       "preserve_lengths_from_head",
-      [](const py::handle& points, const py::handle& rest_lengths) {
+      [](const py::handle& points, const py::handle& rest_lengths, std::optional<double> arc_length) {
         const Vec3List p = to_points(points, "points");
         const auto rest = checked_array<double>(rest_lengths, "rest_lengths", -1, 0);
         const std::vector<Real> lengths(rest.data(), rest.data() + rest.shape(0));
-        return points_array(ffd::preserve_lengths_from_head(p, lengths));
+        return points_array(ffd::preserve_lengths_from_head(p, lengths, arc_length));
       },
-      py::arg("points"), py::arg("rest_lengths"), "Pin point 0 and restore every rest length tailward.");
+      py::arg("points"), py::arg("rest_lengths"), py::arg("arc_length") = py::none(),
+      "Pin point 0 and restore every rest length tailward (optionally matching arc_length, see preserve_lengths).");
 }
 
 }  // namespace kodawari::bind

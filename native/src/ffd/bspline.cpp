@@ -87,6 +87,44 @@ Real CubicBSpline::blend(const std::vector<Real>& values, Real t) const {
   return de_boor(3, span(t), t, values.data(), [this](int j) { return knot(j); });
 }
 
+CubicBasis cubic_basis(int count, Real t) {
+  const int spans = count - 3;
+  auto knot = [spans](int j) { return Real(std::clamp(j - 3, 0, spans)) / Real(spans); };
+  t = std::clamp(t, Real(0), Real(1));
+  const int k = 3 + std::min(static_cast<int>(std::floor(t * spans)), spans - 1);
+  // Triangular Cox-de Boor recursion: N[d][j] = N_{k-d+j, d}(t).
+  Real left[4], right[4], lower[4] = {1, 0, 0, 0}, quadratic[3] = {0, 0, 0};
+  Real current[4];
+  for (int d = 1; d <= 3; ++d) {
+    left[d] = t - knot(k + 1 - d);
+    right[d] = knot(k + d) - t;
+    Real saved = 0;
+    for (int r = 0; r < d; ++r) {
+      const Real temp = lower[r] / (right[r + 1] + left[d - r]);
+      current[r] = saved + right[r + 1] * temp;
+      saved = left[d - r] * temp;
+    }
+    current[d] = saved;
+    for (int r = 0; r <= d; ++r) lower[r] = current[r];
+    if (d == 2) {
+      for (int r = 0; r < 3; ++r) quadratic[r] = current[r];
+    }
+  }
+  CubicBasis basis;
+  basis.first = k - 3;
+  for (int j = 0; j < 4; ++j) {
+    basis.value[j] = lower[j];
+    // dN_{i,3} = 3 N_{i,2} / (U_{i+3} - U_i) - 3 N_{i+1,2} / (U_{i+4} - U_{i+1}), i = k - 3 + j;
+    // the active quadratics are N_{k-2..k,2} = quadratic[0..2].
+    const int i = k - 3 + j;
+    Real slope = 0;
+    if (j >= 1) slope += 3 * quadratic[j - 1] / (knot(i + 3) - knot(i));
+    if (j <= 2) slope -= 3 * quadratic[j] / (knot(i + 4) - knot(i + 1));
+    basis.slope[j] = slope;
+  }
+  return basis;
+}
+
 Real curve_length(const CubicBSpline& curve) {
   // 8-point Gauss-Legendre on 8 sub-intervals per span: exact far below 1e-9 for
   // any reasonable bend (the speed |M'| is smooth within a span).

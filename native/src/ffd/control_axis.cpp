@@ -1,5 +1,6 @@
 #include "kodawari/ffd/control_axis.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -13,6 +14,40 @@ namespace {
 // Below this many vertices per thread, spawning threads costs more than it saves.
 constexpr std::size_t kMinVerticesPerThread = 16384;
 constexpr std::size_t kMinBindVerticesPerThread = 512;
+
+// The deformer's curve is the table's interpolated one, which differs from the
+// exact spline by up to ~5e-6 of the length (mostly along the tangent, as the
+// parameter speed varies). Moving t to where P - O(t) is perpendicular to the
+// interpolated e1 makes the rest rebuild exact up to float rounding.
+void refine_on_table(const FrameTable& table, const Vec3& p, std::uint32_t& segment, float& fraction) {
+  Real f = fraction;
+  int s = static_cast<int>(segment);
+  for (int hop = 0; hop < 4; ++hop) {
+    const TableSegment& seg = table[static_cast<std::size_t>(s)];
+    const Vec3 o = seg.origin.head<3>().cast<Real>(), d_o = seg.d_origin.head<3>().cast<Real>();
+    const Vec3 e1 = seg.e1.head<3>().cast<Real>(), d_e1 = seg.d_e1.head<3>().cast<Real>();
+    for (int iteration = 0; iteration < 4; ++iteration) {
+      const Vec3 r = p - o - f * d_o;
+      const Vec3 tangent = e1 + f * d_e1;
+      const Real g = r.dot(tangent);
+      const Real slope = -d_o.dot(tangent) + r.dot(d_e1);
+      if (!(slope < 0)) break;  // not a minimum of the distance here: keep f
+      f -= g / slope;
+    }
+    if (f < 0 && s > 0) {
+      --s;
+      f = 1;
+    } else if (f > 1 && s < kTableSegments - 1) {
+      ++s;
+      f = 0;
+    } else {
+      break;
+    }
+  }
+  segment = static_cast<std::uint32_t>(s);
+  fraction = static_cast<float>(std::clamp(f, Real(0), Real(1)));
+}
+
 }  // namespace
 
 void validate_twist(const std::vector<Real>& twist, int count) {
@@ -25,28 +60,41 @@ void validate_twist(const std::vector<Real>& twist, int count) {
   }
 }
 
-FrameList axis_frames(const CubicBSpline& curve, const std::vector<Real>& twist, const std::optional<Vec3>& up,
+FrameList axis_frames(const Vec3List& control_points, const std::vector<Real>& twist, const std::optional<Vec3>& up,
                       int samples) {
-  validate_twist(twist, curve.count());
-  const Vec3 tangent = unit_tangent(curve, 0);
-  const Vec3 normal = up ? start_normal_from_up(*up, tangent) : default_start_normal(tangent);
-  return rotation_minimising_frames(curve, twist, normal, samples);
+  validate_control_points(control_points, "control_points");
+  validate_twist(twist, static_cast<int>(control_points.size()));
+  CurveSamples sampled;
+  UniformCurveSampler(static_cast<int>(control_points.size()), samples).sample(control_points, twist, sampled);
+  const Vec3& tangent = sampled.tangent.front();
+  FrameList frames;
+  rotation_minimising_frames(sampled, up ? start_normal_from_up(*up, tangent) : default_start_normal(tangent), frames);
+  return frames;
 }
 
+namespace {
+int checked_count(const Vec3List& control_points) {
+  validate_control_points(control_points, "control_points");
+  return static_cast<int>(control_points.size());
+}
+}  // namespace
+
 AxisBinding::AxisBinding(const Vec3List& control_points, const float* vertices, std::size_t count,
-                         const std::vector<Real>& twist, const std::optional<Vec3>& up, unsigned threads) {
+                         const std::vector<Real>& twist, const std::optional<Vec3>& up, unsigned threads)
+    : control_point_count_(checked_count(control_points)), sampler_(control_point_count_, kTableSegments + 1) {
+  validate_twist(twist, control_point_count_);
   if (count == 0) throw std::invalid_argument("vertices must not be empty");
   for (std::size_t i = 0; i < 3 * count; ++i) {
     if (!std::isfinite(vertices[i])) throw std::invalid_argument("vertices contains NaN or inf");
   }
   const CubicBSpline curve(control_points);
-  control_point_count_ = curve.count();
-  const FrameList frames = axis_frames(curve, twist, up, kTableSegments + 1);
-  rest_tangent_ = frames.front().e1;
-  // The start normal before twist: undo the start twist's roll.
-  const Real start_roll = twist.empty() ? Real(0) : curve.blend(twist, 0);
-  rest_normal_ = std::cos(start_roll) * frames.front().e2 - std::sin(start_roll) * frames.front().e3;
-  std::vector<TableSegment> table;
+  CurveSamples sampled;
+  sampler_.sample(control_points, twist, sampled);
+  rest_tangent_ = sampled.tangent.front();
+  rest_normal_ = up ? start_normal_from_up(*up, rest_tangent_) : default_start_normal(rest_tangent_);
+  FrameList frames;
+  rotation_minimising_frames(sampled, rest_normal_, frames);
+  FrameTable table;
   fill_frame_table(frames, table);
   const ClosestPointFinder finder(curve);
 
@@ -57,11 +105,14 @@ AxisBinding::AxisBinding(const Vec3List& control_points, const float* vertices, 
       const Real t = finder.parameter(p);
       AxisCoordinate& c = coordinates_[i];
       locate_in_table(t, c.segment, c.fraction);
-      float of[3], e1f[3], e2f[3], e3f[3];
-      table_frame(table[c.segment], c.fraction, of, e1f, e2f, e3f);
-      const Vec3 d = p - Vec3(of[0], of[1], of[2]);
-      const Vec3 e1(e1f[0], e1f[1], e1f[2]), e2(e2f[0], e2f[1], e2f[2]), e3(e3f[0], e3f[1], e3f[2]);
-      if (t <= 0 || t >= 1) {
+      if (t > 0 && t < 1) refine_on_table(table, p, c.segment, c.fraction);
+      const bool at_head = c.segment == 0 && c.fraction == 0.0f;
+      const bool at_tail = c.segment == kTableSegments - 1 && c.fraction == 1.0f;
+      const TableFrame frame = table_frame(table[c.segment], c.fraction);
+      const Vec3 d = p - frame.origin.head<3>().cast<Real>();
+      const Vec3 e1 = frame.e1.head<3>().cast<Real>(), e2 = frame.e2.head<3>().cast<Real>(),
+                 e3 = frame.e3.head<3>().cast<Real>();
+      if (at_head || at_tail) {
         // Beyond an end: keep the full offset in the end frame, so the part
         // past the axis (snout, fin tip) follows the end rigidly.
         Mat3 basis;
@@ -92,18 +143,21 @@ float AxisBinding::parameter(std::size_t i) const {
 
 void AxisBinding::deform(const Vec3List& control_points, const std::vector<Real>& twist,
                          const std::optional<Vec3>& up, float* out, unsigned threads) const {
-  const CubicBSpline curve(control_points);
-  if (curve.count() != control_point_count_) {
+  validate_control_points(control_points, "control_points");
+  if (static_cast<int>(control_points.size()) != control_point_count_) {
     throw std::invalid_argument("control_points must have " + std::to_string(control_point_count_) +
                                 " points, as at bind time");
   }
-  validate_twist(twist, curve.count());
-  const Vec3 tangent = unit_tangent(curve, 0);
+  validate_twist(twist, control_point_count_);
+  CurveSamples sampled;
+  sampler_.sample(control_points, twist, sampled);
+  const Vec3& tangent = sampled.tangent.front();
   // Without `up`, the rest start frame follows the start tangent by the
   // smallest rotation, so a pure translation or bend never rolls the body.
   const Vec3 normal = up ? start_normal_from_up(*up, tangent) : carry_normal(rest_normal_, rest_tangent_, tangent);
-  const FrameList frames = rotation_minimising_frames(curve, twist, normal, kTableSegments + 1);
-  std::vector<TableSegment> table;
+  FrameList frames;
+  rotation_minimising_frames(sampled, normal, frames);
+  FrameTable table;
   fill_frame_table(frames, table);
 
   const AxisCoordinate* coords = coordinates_.data();

@@ -5,22 +5,25 @@
 
 namespace kodawari::ffd {
 
-void fill_frame_table(const FrameList& frames, std::vector<TableSegment>& table) {
+namespace {
+Vec4f lanes(const Vec3& v) { return Vec4f(float(v.x()), float(v.y()), float(v.z()), 0.0f); }
+Vec4f lane_delta(const Vec3& from, const Vec3& to) { return lanes(Vec3(to - from)); }
+}  // namespace
+
+void fill_frame_table(const FrameList& frames, FrameTable& table) {
   table.resize(kTableSegments);
   for (int i = 0; i < kTableSegments; ++i) {
     const Frame& a = frames[static_cast<std::size_t>(i)];
     const Frame& b = frames[static_cast<std::size_t>(i) + 1];
     TableSegment& s = table[static_cast<std::size_t>(i)];
-    for (int k = 0; k < 3; ++k) {
-      s.origin[k] = static_cast<float>(a.origin[k]);
-      s.d_origin[k] = static_cast<float>(b.origin[k] - a.origin[k]);
-      s.e1[k] = static_cast<float>(a.e1[k]);
-      s.d_e1[k] = static_cast<float>(b.e1[k] - a.e1[k]);
-      s.e2[k] = static_cast<float>(a.e2[k]);
-      s.d_e2[k] = static_cast<float>(b.e2[k] - a.e2[k]);
-      s.e3[k] = static_cast<float>(a.e3[k]);
-      s.d_e3[k] = static_cast<float>(b.e3[k] - a.e3[k]);
-    }
+    s.origin = lanes(a.origin);
+    s.d_origin = lane_delta(a.origin, b.origin);
+    s.e1 = lanes(a.e1);
+    s.d_e1 = lane_delta(a.e1, b.e1);
+    s.e2 = lanes(a.e2);
+    s.d_e2 = lane_delta(a.e2, b.e2);
+    s.e3 = lanes(a.e3);
+    s.d_e3 = lane_delta(a.e3, b.e3);
   }
 }
 

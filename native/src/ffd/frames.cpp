@@ -39,63 +39,52 @@ Vec3 carry_normal(const Vec3& normal, const Vec3& from, const Vec3& to) {
   return (carried - carried.dot(to) * to).normalized();
 }
 
-Vec3 unit_tangent(const CubicBSpline& curve, Real t) {
-  const Vec3 d = curve.first_derivative(t);
-  const Real speed = d.norm();
-  const Vec3 chord_hint = curve.control_points().back() - curve.control_points().front();
-  const Real scale = chord_hint.norm() + (curve.control_points()[1] - curve.control_points()[0]).norm();
-  if (speed > Real(1e-12) * scale) return d / speed;
-  // A cusp: M'(t) = 0. Use the chord across a small parameter step instead.
-  const Real h = Real(1e-4);
-  const Vec3 chord = curve.point(std::min(Real(1), t + h)) - curve.point(std::max(Real(0), t - h));
-  if (chord.norm() > 0) return chord.normalized();
-  return (curve.control_points()[1] - curve.control_points()[0]).normalized();
-}
-
-FrameList rotation_minimising_frames(const CubicBSpline& curve, const std::vector<Real>& twist,
-                                     const Vec3& start_normal, int samples) {
-  FrameList frames(static_cast<std::size_t>(samples));
-  const Real step = Real(1) / Real(samples - 1);
-  Vec3 x_prev = curve.point(0);
-  Vec3 t_prev = unit_tangent(curve, 0);
-  Vec3 r_prev = start_normal;
-  for (int i = 0; i < samples; ++i) {
-    const Real t = i == samples - 1 ? Real(1) : i * step;
-    Vec3 x = curve.point(t), tangent = unit_tangent(curve, t), r = r_prev;
-    if (i > 0) {
-      // Double reflection: reflect (r, t) in the bisector plane of x_prev -> x,
-      // then in the plane that maps the reflected tangent onto the new tangent.
-      const Vec3 v1 = x - x_prev;
-      const Real c1 = v1.dot(v1);
-      Vec3 r_left = r_prev, t_left = t_prev;
-      if (c1 > 0) {
-        r_left = r_prev - (2 / c1) * v1.dot(r_prev) * v1;
-        t_left = t_prev - (2 / c1) * v1.dot(t_prev) * v1;
-      }
-      const Vec3 v2 = tangent - t_left;
-      const Real c2 = v2.dot(v2);
-      r = c2 > 0 ? Vec3(r_left - (2 / c2) * v2.dot(r_left) * v2) : r_left;
-      // Keep r exactly perpendicular and unit against rounding drift.
-      r = (r - r.dot(tangent) * tangent).normalized();
-    }
-    Frame& f = frames[static_cast<std::size_t>(i)];
-    f.origin = x;
-    f.e1 = tangent;
-    const Vec3 s = tangent.cross(r);
-    if (twist.empty()) {
-      f.e2 = r;
-      f.e3 = s;
-    } else {
-      const Real angle = curve.blend(twist, t);
-      const Real c = std::cos(angle), sn = std::sin(angle);
-      f.e2 = c * r + sn * s;
-      f.e3 = c * s - sn * r;
-    }
-    x_prev = x;
-    t_prev = tangent;
-    r_prev = r;
+void rotation_minimising_frames(const CurveSamples& samples, const Vec3& start_normal, FrameList& frames) {
+  const std::size_t count = samples.origin.size();
+  frames.resize(count);
+  // Pass 1, independent per step: the two reflection planes. v1 is the chord
+  // x_{i-1} -> x_i; v2 maps the tangent reflected in v1 onto t_i. Each plane
+  // is stored as (normal, 2 / |normal|^2), zero when the reflection is void.
+  for (std::size_t i = 1; i < count; ++i) {
+    const Vec3 v1 = samples.origin[i] - samples.origin[i - 1];
+    const Real c1 = v1.dot(v1);
+    const Real k1 = c1 > 0 ? 2 / c1 : Real(0);
+    const Vec3& t_prev = samples.tangent[i - 1];
+    const Vec3 v2 = samples.tangent[i] - (t_prev - k1 * v1.dot(t_prev) * v1);
+    const Real c2 = v2.dot(v2);
+    // Park the planes in the frames' e1/e3 slots until pass 3 overwrites them.
+    frames[i].e1 = v1 * std::sqrt(k1);
+    frames[i].e3 = v2 * (c2 > 0 ? std::sqrt(2 / c2) : Real(0));
   }
-  return frames;
+  // Pass 2, the only sequential part: r_i = H2 H1 r_{i-1}, two reflections
+  // r <- r - (a . r) a with a = v sqrt(2 / |v|^2). Reflections are orthogonal,
+  // so r stays unit up to rounding (renormalised on output, not fed back).
+  Vec3 r = start_normal;
+  frames[0].e2 = r;
+  for (std::size_t i = 1; i < count; ++i) {
+    const Vec3& a1 = frames[i].e1;
+    const Vec3& a2 = frames[i].e3;
+    r -= a1.dot(r) * a1;
+    r -= a2.dot(r) * a2;
+    frames[i].e2 = r;
+  }
+  // Pass 3, independent: exact orthonormal frames, then the twist roll.
+  for (std::size_t i = 0; i < count; ++i) {
+    Frame& f = frames[i];
+    const Vec3& tangent = samples.tangent[i];
+    const Vec3 normal = (f.e2 - f.e2.dot(tangent) * tangent).normalized();
+    const Vec3 binormal = tangent.cross(normal);
+    f.origin = samples.origin[i];
+    f.e1 = tangent;
+    if (samples.roll.empty()) {
+      f.e2 = normal;
+      f.e3 = binormal;
+    } else {
+      const Real c = std::cos(samples.roll[i]), sn = std::sin(samples.roll[i]);
+      f.e2 = c * normal + sn * binormal;
+      f.e3 = c * binormal - sn * normal;
+    }
+  }
 }
 
 }  // namespace kodawari::ffd

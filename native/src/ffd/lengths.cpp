@@ -4,6 +4,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "kodawari/ffd/bspline.hpp"
+
 namespace kodawari::ffd {
 
 std::vector<Real> segment_lengths(const Vec3List& points) {
@@ -27,9 +29,23 @@ Vec3 place_at_distance(const Vec3& anchor, const Vec3& target, const Vec3& fallb
   return anchor + (length / norm) * direction;
 }
 
+// SEEDS §1: from the moved point, toward the head, then toward the tail.
+Vec3List seed_pass(const Vec3List& points, const std::vector<Real>& rest_lengths, long moved_index, Real scale) {
+  const long n = static_cast<long>(points.size());
+  Vec3List out = points;
+  for (long i = moved_index - 1; i >= 0; --i) {
+    out[i] = place_at_distance(out[i + 1], points[i], points[i] - points[i + 1], scale * rest_lengths[i]);
+  }
+  for (long i = moved_index + 1; i < n; ++i) {
+    out[i] = place_at_distance(out[i - 1], points[i], points[i] - points[i - 1], scale * rest_lengths[i - 1]);
+  }
+  return out;
+}
+
 }  // namespace
 
-Vec3List preserve_lengths(const Vec3List& points, const std::vector<Real>& rest_lengths, long moved_index) {
+Vec3List preserve_lengths(const Vec3List& points, const std::vector<Real>& rest_lengths, long moved_index,
+                          std::optional<Real> arc_length) {
   const long n = static_cast<long>(points.size());
   if (n < 2) throw std::invalid_argument("points needs at least 2 points");
   for (const Vec3& p : points) {
@@ -44,18 +60,26 @@ Vec3List preserve_lengths(const Vec3List& points, const std::vector<Real>& rest_
   if (moved_index < 0 || moved_index >= n) {
     throw std::invalid_argument("moved_index must lie in [0, " + std::to_string(n - 1) + "]");
   }
-  Vec3List out = points;
-  for (long i = moved_index - 1; i >= 0; --i) {
-    out[i] = place_at_distance(out[i + 1], points[i], points[i] - points[i + 1], rest_lengths[i]);
+  if (arc_length && !(std::isfinite(*arc_length) && *arc_length > 0)) {
+    throw std::invalid_argument("arc_length must be finite and > 0");
   }
-  for (long i = moved_index + 1; i < n; ++i) {
-    out[i] = place_at_distance(out[i - 1], points[i], points[i] - points[i - 1], rest_lengths[i - 1]);
+  if (arc_length && n < 4) throw std::invalid_argument("points needs at least 4 points to measure arc_length");
+  Vec3List out = seed_pass(points, rest_lengths, moved_index, 1);
+  if (!arc_length) return out;
+  // Arc length is nearly proportional to the common scale: s <- s * target / current.
+  Real scale = 1;
+  for (int step = 0; step < 12; ++step) {
+    const Real current = curve_length(CubicBSpline(out));
+    if (std::abs(current - *arc_length) <= Real(1e-9) * *arc_length) break;
+    scale *= *arc_length / current;
+    out = seed_pass(points, rest_lengths, moved_index, scale);
   }
   return out;
 }
 
-Vec3List preserve_lengths_from_head(const Vec3List& points, const std::vector<Real>& rest_lengths) {
-  return preserve_lengths(points, rest_lengths, 0);
+Vec3List preserve_lengths_from_head(const Vec3List& points, const std::vector<Real>& rest_lengths,
+                                    std::optional<Real> arc_length) {
+  return preserve_lengths(points, rest_lengths, 0, arc_length);
 }
 
 }  // namespace kodawari::ffd

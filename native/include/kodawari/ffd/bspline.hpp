@@ -36,6 +36,16 @@ class CubicBSpline {
   int spans_ = 1;
 };
 
+// The four non-zero basis functions N_{first+j}(t) and their derivatives at t
+// (NURBS Book A2.2 and eq. 2.7), for a clamped uniform cubic B-spline of
+// `count` control points: M(t) = sum_j value[j] P_{first+j}.
+struct CubicBasis {
+  int first = 0;
+  Real value[4] = {0, 0, 0, 0};
+  Real slope[4] = {0, 0, 0, 0};
+};
+CubicBasis cubic_basis(int count, Real t);
+
 // Arc length of the whole curve (Gauss-Legendre quadrature per knot span).
 Real curve_length(const CubicBSpline& curve);
 

@@ -10,6 +10,7 @@
 #include "kodawari/ffd/bspline.hpp"
 #include "kodawari/ffd/frame_table.hpp"
 #include "kodawari/ffd/frames.hpp"
+#include "kodawari/ffd/sampled_curve.hpp"
 
 namespace kodawari::ffd {
 
@@ -17,9 +18,9 @@ namespace kodawari::ffd {
 // `count` finite values.
 void validate_twist(const std::vector<Real>& twist, int count);
 
-// Frames of a curve at `samples` evenly spaced t; the start e2 comes from `up`
-// when given, else from default_start_normal.
-FrameList axis_frames(const CubicBSpline& curve, const std::vector<Real>& twist, const std::optional<Vec3>& up,
+// Frames of the curve of `control_points` at `samples` evenly spaced t; the
+// start e2 comes from `up` when given, else from default_start_normal.
+FrameList axis_frames(const Vec3List& control_points, const std::vector<Real>& twist, const std::optional<Vec3>& up,
                       int samples);
 
 class AxisBinding {
@@ -42,6 +43,7 @@ class AxisBinding {
 
  private:
   int control_point_count_ = 0;
+  UniformCurveSampler sampler_;
   Vec3 rest_tangent_ = Vec3::UnitX();
   Vec3 rest_normal_ = Vec3::UnitY();
   std::vector<AxisCoordinate> coordinates_;

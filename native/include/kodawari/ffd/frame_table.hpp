@@ -14,10 +14,15 @@ namespace kodawari::ffd {
 
 constexpr int kTableSegments = 1024;
 
+// xyz in the first three lanes, 0 in the fourth: one SSE register per vector.
+using Vec4f = Eigen::Vector4f;
+
 struct TableSegment {
-  // origin, e1, e2, e3 at the segment start, then their change across the segment
-  float origin[3], d_origin[3], e1[3], d_e1[3], e2[3], d_e2[3], e3[3], d_e3[3];
+  EIGEN_MAKE_ALIGNED_OPERATOR_NEW
+  // origin and e1..e3 at the segment start, then their change across the segment
+  Vec4f origin, d_origin, e1, d_e1, e2, d_e2, e3, d_e3;
 };
+using FrameTable = std::vector<TableSegment, Eigen::aligned_allocator<TableSegment>>;
 
 // Where a vertex sits: segment, fraction in it, and its offsets in the frame.
 struct AxisCoordinate {
@@ -27,27 +32,30 @@ struct AxisCoordinate {
 
 // Fills `table` (resized to kTableSegments, no growth after the first call)
 // from kTableSegments + 1 frames.
-void fill_frame_table(const FrameList& frames, std::vector<TableSegment>& table);
+void fill_frame_table(const FrameList& frames, FrameTable& table);
 
 // The segment and fraction of parameter t in [0, 1].
 void locate_in_table(Real t, std::uint32_t& segment, float& fraction);
 
-// Interpolated frame at (segment, fraction), in the exact float arithmetic the
-// deform uses, so that bind's offsets rebuild the rest mesh.
-inline void table_frame(const TableSegment& s, float f, float origin[3], float e1[3], float e2[3], float e3[3]) {
-  for (int k = 0; k < 3; ++k) {
-    origin[k] = s.origin[k] + f * s.d_origin[k];
-    e1[k] = s.e1[k] + f * s.d_e1[k];
-    e2[k] = s.e2[k] + f * s.d_e2[k];
-    e3[k] = s.e3[k] + f * s.d_e3[k];
-  }
+struct TableFrame {
+  Vec4f origin, e1, e2, e3;
+};
+
+// Interpolated frame at (segment, fraction), in float like the deform.
+inline TableFrame table_frame(const TableSegment& s, float f) {
+  return {s.origin + f * s.d_origin, s.e1 + f * s.d_e1, s.e2 + f * s.d_e2, s.e3 + f * s.d_e3};
 }
 
-// P' = M(t) + u e2 + v e3 + w e1 (SEEDS §1 eq. 3.2, plus w beyond the ends).
+// P' = M(t) + u e2 + v e3 + w e1 (SEEDS §1 eq. 3.2, plus w beyond the ends),
+// with the frame interpolated linearly within the segment. Four-lane float
+// arithmetic, the same for every vertex whichever thread computes it.
 inline void deform_vertex(const TableSegment& s, const AxisCoordinate& c, float* out) {
-  float origin[3], e1[3], e2[3], e3[3];
-  table_frame(s, c.fraction, origin, e1, e2, e3);
-  for (int k = 0; k < 3; ++k) out[k] = origin[k] + c.u * e2[k] + c.v * e3[k] + c.w * e1[k];
+  const float f = c.fraction;
+  const Vec4f p = (s.origin + c.u * s.e2 + c.v * s.e3 + c.w * s.e1) +
+                  f * (s.d_origin + c.u * s.d_e2 + c.v * s.d_e3 + c.w * s.d_e1);
+  out[0] = p[0];
+  out[1] = p[1];
+  out[2] = p[2];
 }
 
 }  // namespace kodawari::ffd

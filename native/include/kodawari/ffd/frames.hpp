@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "kodawari/common.hpp"
-#include "kodawari/ffd/bspline.hpp"
+#include "kodawari/ffd/sampled_curve.hpp"
 
 namespace kodawari::ffd {
 
@@ -31,13 +31,10 @@ Vec3 start_normal_from_up(const Vec3& up, const Vec3& tangent);
 // about `normal` itself, so the result stays deterministic.
 Vec3 carry_normal(const Vec3& normal, const Vec3& from, const Vec3& to);
 
-// Unit tangent at t; where M'(t) vanishes (a cusp) the chord direction nearby.
-Vec3 unit_tangent(const CubicBSpline& curve, Real t);
-
-// Frames at t = i / (samples - 1), i = 0..samples-1, samples >= 2. `twist` is
-// empty (no roll) or holds one angle per control point. `start_normal` is e2
-// at t = 0 before the twist; it must be unit and perpendicular to the tangent.
-FrameList rotation_minimising_frames(const CubicBSpline& curve, const std::vector<Real>& twist,
-                                     const Vec3& start_normal, int samples);
+// Frames at the sampled points. `start_normal` is e2 at the first sample
+// before the roll; it must be unit and perpendicular to the first tangent.
+// Each step is one double reflection (Wang et al. 2008, Sec. 4), then every
+// frame is rolled about e1 by the sampled twist.
+void rotation_minimising_frames(const CurveSamples& samples, const Vec3& start_normal, FrameList& frames);
 
 }  // namespace kodawari::ffd
