@@ -249,3 +249,34 @@ def test_spine_bends_into_the_turns_of_a_path(empty_scene):
     positions = evaluated(obj) @ world[:3, :3].T + world[:3, 3]
     radii = np.linalg.norm(positions[:, :2] - np.array(circle.location[:2]), axis=1)
     assert np.abs(radii - 2.0).max() < 0.1
+
+
+def test_user_shape_keys_added_later_apply_on_top(empty_scene):
+    set_fps(24)
+    obj = make_fish("tuna")
+    add_swim(obj, head_axis="POS_X")
+    bpy.context.scene.frame_set(4)
+    swim = live(obj).copy()
+    smile = obj.shape_key_add(name="Smile", from_mix=False)
+    offsets = np.zeros_like(swim)
+    offsets[:, 2] = 0.01
+    smile.data.foreach_set("co", (rest(obj) + offsets).reshape(-1))
+    smile.value = 1.0
+    bpy.context.scene.frame_set(4)
+    assert obj.data.shape_keys.key_blocks[1].name == SHAPE_KEY  # first after the Basis
+    assert np.abs(evaluated(obj) - (swim + offsets)).max() < 1e-5
+
+
+def test_axis_overlay_follows_the_swimming_axis(empty_scene):
+    from kodawari.fish import overlay
+
+    obj = make_fish("eel")
+    obj.location = (1.0, 2.0, 3.0)
+    add_swim(obj, head_axis="POS_X", preset="ANGUILLIFORM")
+    bpy.context.scene.frame_set(5)
+    curve, points = overlay.axis_polylines(obj)
+    assert points.shape == (16, 3) and curve.shape == (overlay.CURVE_SAMPLES, 3)
+    assert np.allclose(curve[0], points[0]) and np.allclose(curve[-1], points[-1])  # clamped ends
+    assert np.allclose(points.mean(axis=0)[:2], (1.0, 2.0), atol=0.1)  # in world space
+    obj.kodawari_swim.show_axis = False
+    assert overlay.axis_polylines(obj) is None

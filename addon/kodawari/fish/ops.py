@@ -75,6 +75,8 @@ class KODAWARI_OT_swim_add(bpy.types.Operator):
             key = obj.shape_key_add(name=SHAPE_KEY, from_mix=False)
             key.value = 1.0
             settings.enabled = True
+        # The handler writes the shape key on frame changes; renders must wait for it.
+        context.scene.render.use_lock_interface = True
         runtime.forget(obj)
         runtime.evaluate(obj, context.scene)
         self.report({"INFO"}, f"Fish Swim on '{obj.name}': {guess}; preset {presets.LABELS[self.preset][0]}")

@@ -2,7 +2,7 @@
 
 import bpy
 
-from . import runtime
+from . import overlay, runtime
 
 
 class KODAWARI_UL_swim_fins(bpy.types.UIList):
@@ -21,6 +21,15 @@ class KODAWARI_PT_swim(bpy.types.Panel):
     bl_space_type = "PROPERTIES"
     bl_region_type = "WINDOW"
     bl_context = "modifier"
+
+    # The axis overlay lives as long as the panel is registered.
+    @classmethod
+    def register(cls):
+        overlay.add()
+
+    @classmethod
+    def unregister(cls):
+        overlay.remove()
 
     @classmethod
     def poll(cls, context):
@@ -61,6 +70,7 @@ class KODAWARI_PT_swim(bpy.types.Panel):
         row = layout.row()
         row.prop(settings, "preserve_length")
         row.prop(settings, "control_points")
+        layout.prop(settings, "show_axis")
         row = layout.row(align=True)
         row.prop(settings, "speed_mode")
         if settings.speed_mode == "STROUHAL":
