@@ -280,3 +280,22 @@ def test_axis_overlay_follows_the_swimming_axis(empty_scene):
     assert np.allclose(points.mean(axis=0)[:2], (1.0, 2.0), atol=0.1)  # in world space
     obj.kodawari_swim.show_axis = False
     assert overlay.axis_polylines(obj) is None
+
+
+def test_bake_without_frames_uses_the_scene_range_and_speed_off_returns_home(empty_scene, tmp_path):
+    set_fps(24)
+    scene = bpy.context.scene
+    scene.frame_start, scene.frame_end = 3, 9
+    obj = make_fish("tuna")
+    settings = add_swim(obj, head_axis="POS_X", frequency=3.0)
+    settings.speed_mode = "BAINBRIDGE"
+    scene.frame_set(9)
+    assert obj.delta_location[0] > 0.1
+    settings.speed_mode = "NONE"
+    assert tuple(obj.delta_location) == (0.0, 0.0, 0.0)
+    cache = tmp_path / "t.pc2"
+    assert bpy.ops.kodawari.swim_bake(filepath=str(cache)) == {"FINISHED"}
+    from kodawari.fish import bake
+
+    start, _, data = bake.read_pc2(str(cache))
+    assert start == 3.0 and data.shape[0] == 7

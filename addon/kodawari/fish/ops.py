@@ -196,6 +196,12 @@ class KODAWARI_OT_swim_fin_add(bpy.types.Operator):
             self.vertex_group = obj.vertex_groups.active.name
         return context.window_manager.invoke_props_dialog(self)
 
+    def draw(self, context):
+        obj = _active_mesh(context)
+        if obj is not None:
+            self.layout.prop_search(self, "vertex_group", obj, "vertex_groups")
+        self.layout.prop(self, "kind")
+
     def execute(self, context):
         obj = _active_mesh(context)
         error = _needs_swim(obj)
@@ -291,8 +297,8 @@ class KODAWARI_OT_swim_bake(bpy.types.Operator):
     bl_label = "Bake Fish Swim"
     bl_options = {"REGISTER", "UNDO"}
 
-    frame_start: IntProperty(name="Start", default=1)
-    frame_end: IntProperty(name="End", default=250)
+    frame_start: IntProperty(name="Start", description="First frame (unset: the scene's start)", default=1)
+    frame_end: IntProperty(name="End", description="Last frame (unset: the scene's end)", default=250)
     target: EnumProperty(
         name="Target",
         items=[("MESH_CACHE", "Mesh Cache", "PC2 point cache beside the .blend, played by a Mesh Cache modifier"),
@@ -305,6 +311,11 @@ class KODAWARI_OT_swim_bake(bpy.types.Operator):
     _timer = None
 
     def _prepare(self, context):
+        # Unset frames mean the scene's range.
+        if not self.properties.is_property_set("frame_start"):
+            self.frame_start = context.scene.frame_start
+        if not self.properties.is_property_set("frame_end"):
+            self.frame_end = context.scene.frame_end
         obj = _active_mesh(context)
         error = _needs_swim(obj)
         if error is None and obj.kodawari_swim.baked != "NONE":
@@ -344,8 +355,6 @@ class KODAWARI_OT_swim_bake(bpy.types.Operator):
         return {"FINISHED"}
 
     def invoke(self, context, event):
-        scene = context.scene
-        self.frame_start, self.frame_end = scene.frame_start, scene.frame_end
         if bpy.app.background:
             return self.execute(context)
         self._baker = self._prepare(context)
@@ -373,8 +382,9 @@ class KODAWARI_OT_swim_bake(bpy.types.Operator):
                 self.report({"ERROR"}, f"Bake failed and was undone: {exc}")
                 return {"CANCELLED"}
             wm.progress_update(self._baker.index)
-            context.area.header_text_set(f"Baking fish swim {self._baker.index}/{len(self._baker.frames)}"
-                                         " (Esc cancels)") if context.area else None
+            if context.area:
+                context.area.header_text_set(
+                    f"Baking fish swim {self._baker.index}/{len(self._baker.frames)} (Esc cancels)")
             if self._baker.done:
                 self._end(context)
                 self._baker.finish()

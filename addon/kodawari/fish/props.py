@@ -34,6 +34,13 @@ def _rebind(self, context):
     _runtime().rebind(self.id_data)
 
 
+def _speed_changed(self, context):
+    # Back to swimming on the spot: put the object where it was before it swam off.
+    if self.speed_mode == "NONE":
+        self.id_data.delta_location = self.rest_delta_location
+    _refresh(self, context)
+
+
 def _preset_changed(self, context):
     obj = self.id_data
     with _runtime().batch(obj):
@@ -135,7 +142,7 @@ class KodawariSwimSettings(bpy.types.PropertyGroup):
         items=[("NONE", "None", "Swim on the spot"),
                ("BAINBRIDGE", "Bainbridge", "V = L(3f - 4)/4 (Bainbridge 1958)"),
                ("STROUHAL", "Strouhal", "U = f A / St, A the tail's peak-to-peak excursion")],
-        default="NONE", update=_refresh,
+        default="NONE", update=_speed_changed,
     )
     strouhal: FloatProperty(name="Strouhal", description="Strouhal number St = f A / U (0.2-0.4 in nature)",
                             default=0.3, min=0.05, max=2.0, update=_refresh)
