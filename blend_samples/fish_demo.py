@@ -15,11 +15,13 @@ import bpy
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-import fish_shapes  # noqa: E402
+import fish_shapes
 
-OUT = os.environ.get("KODAWARI_OUT", os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "out"))
+OUT = os.environ.get(
+    "KODAWARI_OUT", os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "out")
+)
 TILE = (240, 136)
-FRAMES = (1, 4, 7, 10)   # a quarter beat apart at 2 Hz, 24 fps
+FRAMES = (1, 4, 7, 10)  # a quarter beat apart at 2 Hz, 24 fps
 
 FISH = (
     # kind, preset, colour body, colour fins, frequency
@@ -31,7 +33,12 @@ FISH = (
     ("dolphin", "CETACEAN", (0.35, 0.38, 0.45), (0.3, 0.33, 0.4), 2.0),
 )
 
-FIN_KIND = {"fin_dorsal": "DORSAL", "fin_anal": "ANAL", "fin_pectoral": "PECTORAL", "fin_caudal": "CAUDAL"}
+FIN_KIND = {
+    "fin_dorsal": "DORSAL",
+    "fin_anal": "ANAL",
+    "fin_pectoral": "PECTORAL",
+    "fin_caudal": "CAUDAL",
+}
 
 
 def material(name, colour):
@@ -53,9 +60,11 @@ def build_scene():
         col, row = i % 3, i // 3
         # Diagonal rows: separated both from above (y) and from the side (z).
         location = (col * 1.3 - 1.3, -row * 0.75, -row * 0.6)
-        obj = fish_shapes.build_fish(kind, location=location,
-                                     materials=(material(kind + "_body", body_colour),
-                                                material(kind + "_fins", fin_colour)))
+        obj = fish_shapes.build_fish(
+            kind,
+            location=location,
+            materials=(material(kind + "_body", body_colour), material(kind + "_fins", fin_colour)),
+        )
         bpy.context.view_layer.objects.active = obj
         obj.select_set(True)
         bpy.ops.kodawari.swim_add(head_axis="AUTO", preset=preset, frequency=frequency)
@@ -125,18 +134,22 @@ def main():
     width, height = TILE
     gap = 3
     columns = 2 * len(FRAMES)
-    sheet = np.ones(((height + gap) * len(fish), (width + gap) * columns + gap * 3, 4), dtype=np.float32)
+    sheet = np.ones(
+        ((height + gap) * len(fish), (width + gap) * columns + gap * 3, 4), dtype=np.float32
+    )
     for row, obj in enumerate(fish):
         for other in fish:
             other.hide_render = other is not obj
         aim(top, side, obj)
         for view, camera in enumerate((top, side)):
             for c, frame in enumerate(FRAMES):
-                tile = render_tile(scene, camera, frame, os.path.join(OUT, f"_tile_{row}_{view}_{c}.png"))
+                tile = render_tile(
+                    scene, camera, frame, os.path.join(OUT, f"_tile_{row}_{view}_{c}.png")
+                )
                 # Image rows run bottom-up: the first fish goes to the top of the sheet.
                 y0 = sheet.shape[0] - (row + 1) * (height + gap)
                 x0 = (view * len(FRAMES) + c) * (width + gap) + view * gap * 3
-                sheet[y0:y0 + height, x0:x0 + width] = tile
+                sheet[y0 : y0 + height, x0 : x0 + width] = tile
     for obj in fish:
         obj.hide_render = False
     bpy.ops.wm.save_as_mainfile(filepath=os.path.join(OUT, "fish.blend"))

@@ -14,37 +14,97 @@ import numpy as np
 # profile(s): half-width, half-height at body fraction s (0 snout, 1 tail tip), superellipse power,
 # fins: kind -> plate description.
 SPECS = {
-    "tuna": dict(width=0.085, height=0.11, peak=0.38, peduncle=0.012, power=2.0, bulge=0.55,
-                 fins={"dorsal": dict(start=0.42, end=0.55, height=0.09, sweep=0.08),
-                       "anal": dict(start=0.58, end=0.68, height=0.07, sweep=0.06),
-                       "pectoral": dict(at=0.3, span=0.06, length=0.14, droop=0.3, sweep=0.8),
-                       "caudal": dict(height=0.30, length=0.16, fork=0.7)}),
-    "eel": dict(width=0.03, height=0.035, peak=0.25, peduncle=0.01, power=2.0, bulge=0.9,
-                fins={"dorsal": dict(start=0.35, end=0.97, height=0.03, sweep=0.0),
-                      "anal": dict(start=0.5, end=0.97, height=0.025, sweep=0.0),
-                      "pectoral": dict(at=0.13, span=0.02, length=0.035, droop=0.0, sweep=0.6)}),
-    "boxfish": dict(width=0.14, height=0.16, peak=0.45, peduncle=0.03, power=5.0, bulge=0.3, tail_start=0.8,
-                    fins={"pectoral": dict(at=0.33, span=0.06, length=0.09, droop=0.1, sweep=0.7),
-                          "caudal": dict(height=0.22, length=0.2, fork=0.0),
-                          "dorsal": dict(start=0.66, end=0.74, height=0.06, sweep=0.05),
-                          "anal": dict(start=0.66, end=0.74, height=0.05, sweep=0.05)}),
-    "filefish": dict(width=0.04, height=0.22, peak=0.42, peduncle=0.02, power=2.0, bulge=0.45,
-                     fins={"dorsal": dict(start=0.5, end=0.82, height=0.08, sweep=0.02),
-                           "anal": dict(start=0.5, end=0.82, height=0.08, sweep=0.02),
-                           "pectoral": dict(at=0.36, span=0.05, length=0.06, droop=0.0, sweep=0.6),
-                           "caudal": dict(height=0.16, length=0.12, fork=0.0)}),
-    "pufferfish": dict(width=0.22, height=0.2, peak=0.45, peduncle=0.03, power=2.0, bulge=0.35,
-                       fins={"pectoral": dict(at=0.4, span=0.1, length=0.14, droop=0.0, sweep=0.5),
-                             "dorsal": dict(start=0.72, end=0.8, height=0.06, sweep=0.04),
-                             "anal": dict(start=0.72, end=0.8, height=0.05, sweep=0.04),
-                             "caudal": dict(height=0.16, length=0.12, fork=0.0)}),
-    "dolphin": dict(width=0.08, height=0.09, peak=0.35, peduncle=0.018, power=2.0, bulge=0.6,
-                    fins={"dorsal": dict(start=0.42, end=0.56, height=0.1, sweep=0.12),
-                          "pectoral": dict(at=0.24, span=0.05, length=0.13, droop=0.6, sweep=0.8),
-                          "fluke": dict(width=0.32, length=0.12, fork=0.5)}),
+    "tuna": {
+        "width": 0.085,
+        "height": 0.11,
+        "peak": 0.38,
+        "peduncle": 0.012,
+        "power": 2.0,
+        "bulge": 0.55,
+        "fins": {
+            "dorsal": {"start": 0.42, "end": 0.55, "height": 0.09, "sweep": 0.08},
+            "anal": {"start": 0.58, "end": 0.68, "height": 0.07, "sweep": 0.06},
+            "pectoral": {"at": 0.3, "span": 0.06, "length": 0.14, "droop": 0.3, "sweep": 0.8},
+            "caudal": {"height": 0.30, "length": 0.16, "fork": 0.7},
+        },
+    },
+    "eel": {
+        "width": 0.03,
+        "height": 0.035,
+        "peak": 0.25,
+        "peduncle": 0.01,
+        "power": 2.0,
+        "bulge": 0.9,
+        "fins": {
+            "dorsal": {"start": 0.35, "end": 0.97, "height": 0.03, "sweep": 0.0},
+            "anal": {"start": 0.5, "end": 0.97, "height": 0.025, "sweep": 0.0},
+            "pectoral": {"at": 0.13, "span": 0.02, "length": 0.035, "droop": 0.0, "sweep": 0.6},
+        },
+    },
+    "boxfish": {
+        "width": 0.14,
+        "height": 0.16,
+        "peak": 0.45,
+        "peduncle": 0.03,
+        "power": 5.0,
+        "bulge": 0.3,
+        "tail_start": 0.8,
+        "fins": {
+            "pectoral": {"at": 0.33, "span": 0.06, "length": 0.09, "droop": 0.1, "sweep": 0.7},
+            "caudal": {"height": 0.22, "length": 0.2, "fork": 0.0},
+            "dorsal": {"start": 0.66, "end": 0.74, "height": 0.06, "sweep": 0.05},
+            "anal": {"start": 0.66, "end": 0.74, "height": 0.05, "sweep": 0.05},
+        },
+    },
+    "filefish": {
+        "width": 0.04,
+        "height": 0.22,
+        "peak": 0.42,
+        "peduncle": 0.02,
+        "power": 2.0,
+        "bulge": 0.45,
+        "fins": {
+            "dorsal": {"start": 0.5, "end": 0.82, "height": 0.08, "sweep": 0.02},
+            "anal": {"start": 0.5, "end": 0.82, "height": 0.08, "sweep": 0.02},
+            "pectoral": {"at": 0.36, "span": 0.05, "length": 0.06, "droop": 0.0, "sweep": 0.6},
+            "caudal": {"height": 0.16, "length": 0.12, "fork": 0.0},
+        },
+    },
+    "pufferfish": {
+        "width": 0.22,
+        "height": 0.2,
+        "peak": 0.45,
+        "peduncle": 0.03,
+        "power": 2.0,
+        "bulge": 0.35,
+        "fins": {
+            "pectoral": {"at": 0.4, "span": 0.1, "length": 0.14, "droop": 0.0, "sweep": 0.5},
+            "dorsal": {"start": 0.72, "end": 0.8, "height": 0.06, "sweep": 0.04},
+            "anal": {"start": 0.72, "end": 0.8, "height": 0.05, "sweep": 0.04},
+            "caudal": {"height": 0.16, "length": 0.12, "fork": 0.0},
+        },
+    },
+    "dolphin": {
+        "width": 0.08,
+        "height": 0.09,
+        "peak": 0.35,
+        "peduncle": 0.018,
+        "power": 2.0,
+        "bulge": 0.6,
+        "fins": {
+            "dorsal": {"start": 0.42, "end": 0.56, "height": 0.1, "sweep": 0.12},
+            "pectoral": {"at": 0.24, "span": 0.05, "length": 0.13, "droop": 0.6, "sweep": 0.8},
+            "fluke": {"width": 0.32, "length": 0.12, "fork": 0.5},
+        },
+    },
 }
 
-AXES = {"POS_X": (0, 1, 2, 1), "NEG_X": (0, 1, 2, -1), "POS_Y": (1, 0, 2, 1), "NEG_Y": (1, 0, 2, -1)}
+AXES = {
+    "POS_X": (0, 1, 2, 1),
+    "NEG_X": (0, 1, 2, -1),
+    "POS_Y": (1, 0, 2, 1),
+    "NEG_Y": (1, 0, 2, -1),
+}
 
 
 def _profile(spec, s):
@@ -82,8 +142,14 @@ def build_arrays(kind, rings=48, segments=24, fin_rows=5, midline_sag=0.0):
     x = 0.5 - s  # snout at +0.5, tail tip at -0.5
     sag = midline_sag * np.sin(math.pi * s)  # a curved mid-line (belly down in the middle)
     ring_y, ring_z = _superellipse(angles[None, :], w[:, None], h[:, None], spec["power"])
-    body = np.stack([np.repeat(x[:, None], segments, 1), ring_y, ring_z - sag[:, None]], axis=-1).reshape(-1, 3)
-    verts = [body, np.array([[0.5 + 0.02, 0.0, -sag[0]]]), np.array([[x[-1] - 0.002, 0.0, -sag[-1]]])]
+    body = np.stack(
+        [np.repeat(x[:, None], segments, 1), ring_y, ring_z - sag[:, None]], axis=-1
+    ).reshape(-1, 3)
+    verts = [
+        body,
+        np.array([[0.5 + 0.02, 0.0, -sag[0]]]),
+        np.array([[x[-1] - 0.002, 0.0, -sag[-1]]]),
+    ]
     snout, tail = len(body), len(body) + 1
     faces = []
     for r in range(rings - 1):
@@ -98,7 +164,7 @@ def build_arrays(kind, rings=48, segments=24, fin_rows=5, midline_sag=0.0):
     groups = {}
 
     def ring_vertex(ring, angle):
-        k = int(round(angle / (2 * math.pi) * segments)) % segments
+        k = round(angle / (2 * math.pi) * segments) % segments
         return ring * segments + k
 
     def add_plate(name, base_idx, outward):
@@ -125,7 +191,7 @@ def build_arrays(kind, rings=48, segments=24, fin_rows=5, midline_sag=0.0):
                 faces.append((index[j, c], index[j, c + 1], index[j + 1, c + 1], index[j + 1, c]))
         groups.setdefault(name, []).extend(index.reshape(-1).tolist())
 
-    ring_of = lambda frac: int(np.clip(np.searchsorted(s, frac), 0, rings - 1))  # noqa: E731
+    ring_of = lambda frac: int(np.clip(np.searchsorted(s, frac), 0, rings - 1))
     for fin_name, fin in spec["fins"].items():
         if fin_name in ("dorsal", "anal"):
             r0, r1 = ring_of(fin["start"]), ring_of(fin["end"])
@@ -139,8 +205,14 @@ def build_arrays(kind, rings=48, segments=24, fin_rows=5, midline_sag=0.0):
 
             def outward(t, c, profile=profile, height=height, sweep=sweep, sign=sign):
                 lift = height * t * profile[c]
-                return np.stack([-sweep * t * profile[c] * np.ones_like(lift), np.zeros_like(lift),
-                                 sign * lift], axis=-1)
+                return np.stack(
+                    [
+                        -sweep * t * profile[c] * np.ones_like(lift),
+                        np.zeros_like(lift),
+                        sign * lift,
+                    ],
+                    axis=-1,
+                )
 
             add_plate(f"fin_{fin_name}", base_idx, outward)
         elif fin_name == "pectoral":
@@ -182,7 +254,9 @@ def build_arrays(kind, rings=48, segments=24, fin_rows=5, midline_sag=0.0):
             index = np.arange(start, start + grid.size // 3).reshape(fin_rows + 1, cols)
             for j in range(fin_rows):
                 for c in range(cols - 1):
-                    faces.append((index[j, c], index[j, c + 1], index[j + 1, c + 1], index[j + 1, c]))
+                    faces.append(
+                        (index[j, c], index[j, c + 1], index[j + 1, c + 1], index[j + 1, c])
+                    )
             groups["fin_caudal"] = index.reshape(-1).tolist()
             del body_extra
         elif fin_name == "fluke":
@@ -205,7 +279,9 @@ def build_arrays(kind, rings=48, segments=24, fin_rows=5, midline_sag=0.0):
             index = np.arange(start, start + grid.size // 3).reshape(fin_rows + 1, cols)
             for j in range(fin_rows):
                 for c in range(cols - 1):
-                    faces.append((index[j, c], index[j, c + 1], index[j + 1, c + 1], index[j + 1, c]))
+                    faces.append(
+                        (index[j, c], index[j, c + 1], index[j + 1, c + 1], index[j + 1, c])
+                    )
             groups["fin_caudal"] = index.reshape(-1).tolist()
     return np.concatenate(verts), faces, groups, len(body)
 
@@ -214,8 +290,19 @@ def body_face_count(rings=48, segments=24):
     return (rings - 1) * segments + 2 * segments
 
 
-def build_fish(kind, name=None, head_axis="POS_X", scale=1.0, location=(0.0, 0.0, 0.0), rings=48, segments=24,
-               fin_rows=5, midline_sag=0.0, collection=None, materials=None):
+def build_fish(
+    kind,
+    name=None,
+    head_axis="POS_X",
+    scale=1.0,
+    location=(0.0, 0.0, 0.0),
+    rings=48,
+    segments=24,
+    fin_rows=5,
+    midline_sag=0.0,
+    collection=None,
+    materials=None,
+):
     """A mesh object for `kind` with one vertex group per fin; returns the object."""
     verts, faces, groups, _ = build_arrays(kind, rings, segments, fin_rows, midline_sag)
     a, b, c, sign = AXES[head_axis]
@@ -230,7 +317,7 @@ def build_fish(kind, name=None, head_axis="POS_X", scale=1.0, location=(0.0, 0.0
         for material in materials:
             mesh.materials.append(material)
         index = np.zeros(len(mesh.polygons), dtype=np.int32)
-        index[body_face_count(rings, segments):] = len(materials) - 1  # fins use the last material
+        index[body_face_count(rings, segments) :] = len(materials) - 1  # fins use the last material
         mesh.polygons.foreach_set("material_index", index)
         mesh.polygons.foreach_set("use_smooth", np.ones(len(mesh.polygons), dtype=bool))
     mesh.update()
@@ -239,7 +326,7 @@ def build_fish(kind, name=None, head_axis="POS_X", scale=1.0, location=(0.0, 0.0
     (collection or bpy.context.scene.collection).objects.link(obj)
     for group_name, indices in groups.items():
         group = obj.vertex_groups.new(name=group_name)
-        group.add(sorted(set(int(i) for i in indices)), 1.0, "REPLACE")
+        group.add(sorted({int(i) for i in indices}), 1.0, "REPLACE")
     return obj
 
 

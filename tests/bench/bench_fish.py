@@ -20,7 +20,7 @@ import numpy as np
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 sys.path.insert(0, os.path.join(ROOT, "blend_samples"))
-import fish_shapes  # noqa: E402
+import fish_shapes
 
 FRAMES = 8
 
@@ -34,8 +34,9 @@ def _fish(rings, segments, fins=True):
     obj.select_set(True)
     bpy.ops.kodawari.swim_add(head_axis="POS_X", preset="CARANGIFORM", frequency=2.0)
     for group in obj.vertex_groups:
-        bpy.ops.kodawari.swim_fin_add(vertex_group=group.name,
-                                      kind=group.name.split("_")[1].upper())
+        bpy.ops.kodawari.swim_fin_add(
+            vertex_group=group.name, kind=group.name.split("_")[1].upper()
+        )
     obj.select_set(False)
     return obj
 
@@ -103,7 +104,7 @@ def _time_curve_modifier(obj):
         curve_data.update_tag()
         t = time.perf_counter()
         depsgraph.update()
-        copy.evaluated_get(depsgraph).data.vertices[0].co  # the modifier has run
+        _ = copy.evaluated_get(depsgraph).data.vertices[0].co  # the modifier has run
         if frame:
             times.append(time.perf_counter() - t)
     obj.hide_viewport = False
@@ -124,19 +125,27 @@ def main():
     kernel, full = _time_ours(big)
     floor = _time_blender_floor(big)
     curve = _time_curve_modifier(big)
-    print(f"1M fish, ours (kernel + write): {kernel * 1e3:8.1f} ms/frame  ({kernel / n_big * 1e9:6.1f} ns/vertex)")
+    print(
+        f"1M fish, ours (kernel + write): {kernel * 1e3:8.1f} ms/frame  ({kernel / n_big * 1e9:6.1f} ns/vertex)"
+    )
     print(f"1M fish, ours (frame):          {full * 1e3:8.1f} ms/frame")
-    print(f"1M fish, Curve modifier:        {curve * 1e3:8.1f} ms/frame  ({curve / n_big * 1e9:6.1f} ns/vertex)")
+    print(
+        f"1M fish, Curve modifier:        {curve * 1e3:8.1f} ms/frame  ({curve / n_big * 1e9:6.1f} ns/vertex)"
+    )
     print(f"ratio Curve modifier / ours (kernel + write): {curve / kernel:5.1f}x   (target >= 10x)")
     print(f"1M fish, Blender's own mesh update (no deformer): {floor * 1e3:6.1f} ms/frame")
     print(f"ratio Curve modifier / ours (frame):          {curve / full:5.1f}x")
-    print(f"ratio (Curve modifier - floor) / ours (kernel + write): {(curve - floor) / kernel:5.1f}x")
+    print(
+        f"ratio (Curve modifier - floor) / ours (kernel + write): {(curve - floor) / kernel:5.1f}x"
+    )
     bpy.data.objects.remove(big)
 
     small = _fish(rings=320, segments=310, fins=True)
     n_small = len(small.data.vertices)
     kernel, full = _time_ours(small)
-    print(f"{n_small:,}-vertex fish, ours (kernel + write): {kernel * 1e3:6.2f} ms/frame (target < 10 ms)")
+    print(
+        f"{n_small:,}-vertex fish, ours (kernel + write): {kernel * 1e3:6.2f} ms/frame (target < 10 ms)"
+    )
     print(f"{n_small:,}-vertex fish, ours (frame):          {full * 1e3:6.2f} ms/frame")
 
 

@@ -8,9 +8,14 @@ import numpy as np
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 sys.path.insert(0, os.path.join(ROOT, "blend_samples"))
-import fish_shapes  # noqa: E402
+import fish_shapes
 
-FIN_KIND = {"fin_dorsal": "DORSAL", "fin_anal": "ANAL", "fin_pectoral": "PECTORAL", "fin_caudal": "CAUDAL"}
+FIN_KIND = {
+    "fin_dorsal": "DORSAL",
+    "fin_anal": "ANAL",
+    "fin_pectoral": "PECTORAL",
+    "fin_caudal": "CAUDAL",
+}
 SHAPE_KEY = "Kodawari Swim"
 
 
@@ -31,7 +36,9 @@ def add_swim(obj, fins=(), **kwargs):
     activate(obj)
     assert bpy.ops.kodawari.swim_add(**kwargs) == {"FINISHED"}
     for group in fins:
-        assert bpy.ops.kodawari.swim_fin_add(vertex_group=group, kind=FIN_KIND[group]) == {"FINISHED"}
+        assert bpy.ops.kodawari.swim_fin_add(vertex_group=group, kind=FIN_KIND[group]) == {
+            "FINISHED"
+        }
     return obj.kodawari_swim
 
 

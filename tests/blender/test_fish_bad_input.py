@@ -7,7 +7,11 @@ from fish_helpers import activate, add_swim, make_fish, rest
 
 
 def _snapshot(obj):
-    state = {"name": obj.name, "type": obj.type, "modifiers": [m.name for m in getattr(obj, "modifiers", [])]}
+    state = {
+        "name": obj.name,
+        "type": obj.type,
+        "modifiers": [m.name for m in getattr(obj, "modifiers", [])],
+    }
     if obj.type == "MESH":
         keys = obj.data.shape_keys
         state.update(
@@ -54,8 +58,9 @@ def test_negative_frequency(empty_scene):
     _refused(bpy.ops.kodawari.swim_add, obj, ["frequency", "-1.5"], frequency=-1.5)
 
 
-@pytest.mark.parametrize("scale,words", [((1.0, 2.0, 1.0), ["non-uniform scale"]),
-                                         ((-1.0, -1.0, -1.0), ["negative"])])
+@pytest.mark.parametrize(
+    "scale,words", [((1.0, 2.0, 1.0), ["non-uniform scale"]), ((-1.0, -1.0, -1.0), ["negative"])]
+)
 def test_bad_object_scale(empty_scene, scale, words):
     obj = make_fish("tuna")
     obj.scale = scale
@@ -78,8 +83,13 @@ def test_existing_modifiers(empty_scene):
 def test_unknown_vertex_group(empty_scene):
     obj = make_fish("tuna")
     add_swim(obj, head_axis="POS_X")
-    _refused(bpy.ops.kodawari.swim_fin_add, obj, ["no vertex group 'fin_tail'"], vertex_group="fin_tail",
-             kind="CAUDAL")
+    _refused(
+        bpy.ops.kodawari.swim_fin_add,
+        obj,
+        ["no vertex group 'fin_tail'"],
+        vertex_group="fin_tail",
+        kind="CAUDAL",
+    )
     _refused(bpy.ops.kodawari.swim_fin_add, obj, ["vertex group"], vertex_group="", kind="CAUDAL")
 
 
@@ -87,7 +97,13 @@ def test_empty_vertex_group(empty_scene):
     obj = make_fish("tuna")
     obj.vertex_groups.new(name="fin_empty")
     add_swim(obj, head_axis="POS_X")
-    _refused(bpy.ops.kodawari.swim_fin_add, obj, ["'fin_empty' is empty"], vertex_group="fin_empty", kind="DORSAL")
+    _refused(
+        bpy.ops.kodawari.swim_fin_add,
+        obj,
+        ["'fin_empty' is empty"],
+        vertex_group="fin_empty",
+        kind="DORSAL",
+    )
 
 
 def test_fin_group_covering_most_of_the_mesh(empty_scene):
@@ -95,19 +111,36 @@ def test_fin_group_covering_most_of_the_mesh(empty_scene):
     group = obj.vertex_groups.new(name="everything")
     group.add(list(range(int(0.8 * len(obj.data.vertices)))), 1.0, "REPLACE")
     add_swim(obj, head_axis="POS_X")
-    _refused(bpy.ops.kodawari.swim_fin_add, obj, ["covers 80%", "not the body"], vertex_group="everything",
-             kind="DORSAL")
+    _refused(
+        bpy.ops.kodawari.swim_fin_add,
+        obj,
+        ["covers 80%", "not the body"],
+        vertex_group="everything",
+        kind="DORSAL",
+    )
 
 
 def test_fin_on_a_mesh_that_does_not_swim(empty_scene):
     obj = make_fish("tuna")
-    _refused(bpy.ops.kodawari.swim_fin_add, obj, ["does not swim"], vertex_group="fin_dorsal", kind="DORSAL")
+    _refused(
+        bpy.ops.kodawari.swim_fin_add,
+        obj,
+        ["does not swim"],
+        vertex_group="fin_dorsal",
+        kind="DORSAL",
+    )
 
 
 def test_same_fin_twice(empty_scene):
     obj = make_fish("tuna")
     add_swim(obj, fins=("fin_dorsal",), head_axis="POS_X")
-    _refused(bpy.ops.kodawari.swim_fin_add, obj, ["already a fin"], vertex_group="fin_dorsal", kind="DORSAL")
+    _refused(
+        bpy.ops.kodawari.swim_fin_add,
+        obj,
+        ["already a fin"],
+        vertex_group="fin_dorsal",
+        kind="DORSAL",
+    )
 
 
 def test_swim_add_twice_and_remove_without_swim(empty_scene):
@@ -120,8 +153,14 @@ def test_swim_add_twice_and_remove_without_swim(empty_scene):
 def test_bake_with_reversed_frame_range(empty_scene, tmp_path):
     obj = make_fish("tuna")
     add_swim(obj, head_axis="POS_X")
-    _refused(bpy.ops.kodawari.swim_bake, obj, ["end frame 3 comes before the start frame 10"], frame_start=10,
-             frame_end=3, filepath=str(tmp_path / "x.pc2"))
+    _refused(
+        bpy.ops.kodawari.swim_bake,
+        obj,
+        ["end frame 3 comes before the start frame 10"],
+        frame_start=10,
+        frame_end=3,
+        filepath=str(tmp_path / "x.pc2"),
+    )
     assert not (tmp_path / "x.pc2").exists()
 
 
@@ -146,5 +185,13 @@ def test_bake_cancel_leaves_everything_as_it_was(empty_scene, tmp_path):
         assert obj.kodawari_swim.baked == "NONE"
     # Live evaluation still runs afterwards.
     scene.frame_set(6)
-    assert np.abs(rest(obj) - np.array([v.co[:] for v in obj.data.shape_keys.key_blocks["Kodawari Swim"].data],
-                                       dtype=np.float32)).max() > 0
+    assert (
+        np.abs(
+            rest(obj)
+            - np.array(
+                [v.co[:] for v in obj.data.shape_keys.key_blocks["Kodawari Swim"].data],
+                dtype=np.float32,
+            )
+        ).max()
+        > 0
+    )

@@ -2,11 +2,23 @@
 
 import numpy as np
 import pytest
-from fish_helpers import add_swim, body_length, fin_mask, fish_shapes, frames, group_mask, make_fish, rest, set_fps
+from fish_helpers import (
+    add_swim,
+    body_length,
+    fin_mask,
+    fish_shapes,
+    frames,
+    group_mask,
+    make_fish,
+    rest,
+    set_fps,
+)
 
 
 def _motion(obj, frame_list):
-    return np.linalg.norm(frames(obj, frame_list) - rest(obj)[None], axis=2).max(axis=0)  # per vertex
+    return np.linalg.norm(frames(obj, frame_list) - rest(obj)[None], axis=2).max(
+        axis=0
+    )  # per vertex
 
 
 def test_ostraciiform_body_stays_rigid_except_the_caudal_fin(empty_scene):
@@ -20,14 +32,23 @@ def test_ostraciiform_body_stays_rigid_except_the_caudal_fin(empty_scene):
     assert moved[caudal].max() > 0.05 * length
 
 
-@pytest.mark.parametrize("kind,preset,moving", [
-    ("pufferfish", "LABRIFORM", ("fin_pectoral",)),
-    ("filefish", "BALISTIFORM", ("fin_dorsal", "fin_anal")),
-])
+@pytest.mark.parametrize(
+    "kind,preset,moving",
+    [
+        ("pufferfish", "LABRIFORM", ("fin_pectoral",)),
+        ("filefish", "BALISTIFORM", ("fin_dorsal", "fin_anal")),
+    ],
+)
 def test_body_stays_still_while_fins_move(empty_scene, kind, preset, moving):
     set_fps(24)
     obj = make_fish(kind)
-    add_swim(obj, fins=tuple(g.name for g in obj.vertex_groups), head_axis="POS_X", preset=preset, frequency=2.0)
+    add_swim(
+        obj,
+        fins=tuple(g.name for g in obj.vertex_groups),
+        head_axis="POS_X",
+        preset=preset,
+        frequency=2.0,
+    )
     moved = _motion(obj, range(1, 13))
     length = body_length(obj)
     body = ~fin_mask(obj)
@@ -36,8 +57,15 @@ def test_body_stays_still_while_fins_move(empty_scene, kind, preset, moving):
         assert moved[group_mask(obj, group)].max() > 0.02 * length, group
 
 
-@pytest.mark.parametrize("kind,preset", [("tuna", "CARANGIFORM"), ("pufferfish", "LABRIFORM"),
-                                         ("filefish", "BALISTIFORM"), ("eel", "ANGUILLIFORM")])
+@pytest.mark.parametrize(
+    "kind,preset",
+    [
+        ("tuna", "CARANGIFORM"),
+        ("pufferfish", "LABRIFORM"),
+        ("filefish", "BALISTIFORM"),
+        ("eel", "ANGUILLIFORM"),
+    ],
+)
 def test_fin_roots_stay_where_they_sit_on_the_body(empty_scene, kind, preset):
     set_fps(24)
     obj = make_fish(kind)
@@ -52,7 +80,9 @@ def test_fin_roots_stay_where_they_sit_on_the_body(empty_scene, kind, preset):
     assert gap.max() < 0.01 * body_length(obj), gap.max()
     # ...while the fins' outer parts do move away from the body's motion.
     tips = fin_mask(obj)
-    assert np.linalg.norm(positions[:, tips] - rest(obj)[tips], axis=2).max() > 0.03 * body_length(obj)
+    assert np.linalg.norm(positions[:, tips] - rest(obj)[tips], axis=2).max() > 0.03 * body_length(
+        obj
+    )
 
 
 def test_pectoral_flap_feathers_edge_on_during_recovery(empty_scene):
@@ -63,7 +93,9 @@ def test_pectoral_flap_feathers_edge_on_during_recovery(empty_scene):
     fin.feathering = np.pi / 2
     pectoral = np.flatnonzero(group_mask(obj, "fin_pectoral"))
     right = pectoral[rest(obj)[pectoral, 1] > 0]
-    right = right[rest(obj)[right, 1] > np.median(rest(obj)[right, 1])]  # the outer half of the blade
+    right = right[
+        rest(obj)[right, 1] > np.median(rest(obj)[right, 1])
+    ]  # the outer half of the blade
 
     def blade_normal_x(points):
         # The blade's normal (least-variance direction): across the fore/aft stroke
@@ -74,5 +106,5 @@ def test_pectoral_flap_feathers_edge_on_during_recovery(empty_scene):
 
     positions = frames(obj, [1, 13])  # phase 0: mid power stroke; phase π: mid recovery
     power, recovery = blade_normal_x(positions[0][right]), blade_normal_x(positions[1][right])
-    assert power > 0.8, power        # blade across the fore/aft stroke
+    assert power > 0.8, power  # blade across the fore/aft stroke
     assert recovery < 0.3, recovery  # edge-on

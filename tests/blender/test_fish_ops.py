@@ -5,15 +5,24 @@ import os
 import bpy
 import numpy as np
 import pytest
-from fish_helpers import (SHAPE_KEY, activate, add_swim, body_length, evaluated, frames, live, make_fish, rest,
-                          set_fps)
+from fish_helpers import (
+    SHAPE_KEY,
+    add_swim,
+    body_length,
+    evaluated,
+    frames,
+    live,
+    make_fish,
+    rest,
+    set_fps,
+)
 
 
 def _keyframe_frequency(obj, values):
     settings = obj.kodawari_swim
     for frame, value in values:
         settings.frequency = value
-        obj.keyframe_insert('kodawari_swim.frequency', frame=frame)
+        obj.keyframe_insert("kodawari_swim.frequency", frame=frame)
     from kodawari import fcurves
 
     curve = fcurves.find_fcurve(obj.animation_data.action, obj, "kodawari_swim.frequency")
@@ -27,7 +36,9 @@ def test_changing_frequency_mid_animation_leaves_no_jump(empty_scene):
     add_swim(obj, head_axis="POS_X", preset="CARANGIFORM", frequency=1.0)
     _keyframe_frequency(obj, [(1, 1.0), (21, 3.0)])  # a sudden step at frame 21
     positions = frames(obj, range(1, 41))
-    steps = np.linalg.norm(np.diff(positions, axis=0), axis=2).max(axis=1)  # largest vertex move per frame
+    steps = np.linalg.norm(np.diff(positions, axis=0), axis=2).max(
+        axis=1
+    )  # largest vertex move per frame
     # At 3 Hz the fastest steady step is ~3x the 1 Hz one; the frame of the change must not exceed it
     # (ω·t would shift the whole wave by 2π·2 Hz·20/24 s in one frame).
     steady_fast = steps[25:].max()
@@ -39,11 +50,23 @@ def test_changing_frequency_mid_animation_leaves_no_jump(empty_scene):
 def test_bake_equals_live(empty_scene, tmp_path, target):
     set_fps(24)
     obj = make_fish("tuna")
-    add_swim(obj, fins=("fin_pectoral", "fin_dorsal"), head_axis="POS_X", preset="CARANGIFORM", frequency=2.0)
+    add_swim(
+        obj,
+        fins=("fin_pectoral", "fin_dorsal"),
+        head_axis="POS_X",
+        preset="CARANGIFORM",
+        frequency=2.0,
+    )
     live_frames = frames(obj, range(1, 13))
     cache = str(tmp_path / "tuna.pc2")
-    assert bpy.ops.kodawari.swim_bake(frame_start=1, frame_end=12, target=target, filepath=cache) == {"FINISHED"}
-    assert obj.kodawari_swim.baked == target and not obj.kodawari_swim.enabled or obj.kodawari_swim.baked == target
+    assert bpy.ops.kodawari.swim_bake(
+        frame_start=1, frame_end=12, target=target, filepath=cache
+    ) == {"FINISHED"}
+    assert (
+        obj.kodawari_swim.baked == target
+        and not obj.kodawari_swim.enabled
+        or obj.kodawari_swim.baked == target
+    )
     if target == "MESH_CACHE":
         assert os.path.isfile(cache)
         assert obj.modifiers[0].type == "MESH_CACHE"
@@ -64,8 +87,9 @@ def test_pc2_file_layout(empty_scene, tmp_path):
         header = handle.read(32)
         data = np.frombuffer(handle.read(), dtype="<f4")
     assert header[:12] == b"POINTCACHE2\0"
-    version, points, start, rate, samples = np.frombuffer(header[12:], dtype=[
-        ("v", "<i4"), ("n", "<i4"), ("s", "<f4"), ("r", "<f4"), ("k", "<i4")])[0]
+    version, points, start, rate, samples = np.frombuffer(
+        header[12:], dtype=[("v", "<i4"), ("n", "<i4"), ("s", "<f4"), ("r", "<f4"), ("k", "<i4")]
+    )[0]
     assert (version, points, start, rate, samples) == (1, len(obj.data.vertices), 5.0, 1.0, 4)
     assert np.array_equal(data.reshape(4, points, 3), live_frames)
 
@@ -94,7 +118,9 @@ def test_settings_survive_save_and_reload(empty_scene, tmp_path):
     assert settings.amplitude == pytest.approx(0.11) and settings.wavelength == pytest.approx(1.3)
     assert settings.speed_mode == "STROUHAL" and settings.strouhal == pytest.approx(0.27)
     assert settings.fins[0].vertex_group == "fin_pectoral"
-    assert settings.fins[0].feathering == pytest.approx(0.5) and settings.fins[0].phase_lag == pytest.approx(1.1)
+    assert settings.fins[0].feathering == pytest.approx(0.5) and settings.fins[
+        0
+    ].phase_lag == pytest.approx(1.1)
     # The runtime is rebuilt from the file: the same frame gives the same pose.
     bpy.context.scene.frame_set(3)
     bpy.context.scene.frame_set(7)
@@ -126,7 +152,9 @@ def test_swim_remove_restores_the_original_mesh_exactly(empty_scene, tmp_path):
     add_swim(obj, fins=("fin_pectoral",), head_axis="POS_X", preset="CETACEAN")
     obj.kodawari_swim.speed_mode = "BAINBRIDGE"
     bpy.context.scene.frame_set(9)
-    bpy.ops.kodawari.swim_bake(frame_start=1, frame_end=5, target="MESH_CACHE", filepath=str(tmp_path / "d.pc2"))
+    bpy.ops.kodawari.swim_bake(
+        frame_start=1, frame_end=5, target="MESH_CACHE", filepath=str(tmp_path / "d.pc2")
+    )
     assert bpy.ops.kodawari.swim_remove() == {"FINISHED"}
     assert obj.data.shape_keys is None and len(obj.modifiers) == 0
     assert tuple(obj.delta_location) == (0.0, 0.0, 0.0)
@@ -200,8 +228,10 @@ def test_fin_finder_makes_vertex_groups_and_fins(empty_scene):
         obj.vertex_groups.remove(group)
     add_swim(obj, head_axis="POS_X")
     assert bpy.ops.kodawari.swim_fin_find() == {"FINISHED"}
-    found = {g.name: {v.index for v in obj.data.vertices for e in v.groups if e.group == g.index}
-             for g in obj.vertex_groups}
+    found = {
+        g.name: {v.index for v in obj.data.vertices for e in v.groups if e.group == g.index}
+        for g in obj.vertex_groups
+    }
     for name in ("fin_dorsal", "fin_pectoral", "fin_caudal"):
         assert name in found, found.keys()
         overlap = len(found[name] & truth[name]) / len(found[name] | truth[name])
@@ -243,7 +273,7 @@ def test_spine_bends_into_the_turns_of_a_path(empty_scene):
     to_centre /= np.linalg.norm(to_centre)
     for end in (axis[0], axis[-1]):
         d = abs(end[0] - middle[0])
-        assert (end - middle) @ to_centre == pytest.approx(d ** 2 / (2 * 2.0), rel=0.2)
+        assert (end - middle) @ to_centre == pytest.approx(d**2 / (2 * 2.0), rel=0.2)
     # The whole fish lies along the circle.
     world = np.array(obj.matrix_world)
     positions = evaluated(obj) @ world[:3, :3].T + world[:3, 3]

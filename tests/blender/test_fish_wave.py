@@ -10,8 +10,10 @@ def _tail_and_snout(obj):
     return int(np.argmin(co[:, 0])), int(np.argmax(co[:, 0]))
 
 
-@pytest.mark.parametrize("kind,preset,amplitude", [("tuna", "CARANGIFORM", 0.12), ("tuna", "THUNNIFORM", 0.07),
-                                                   ("eel", "ANGUILLIFORM", 0.08)])
+@pytest.mark.parametrize(
+    "kind,preset,amplitude",
+    [("tuna", "CARANGIFORM", 0.12), ("tuna", "THUNNIFORM", 0.07), ("eel", "ANGUILLIFORM", 0.08)],
+)
 def test_tail_tip_lateral_amplitude_matches_setting(empty_scene, kind, preset, amplitude):
     set_fps(48)
     obj = make_fish(kind)
@@ -44,10 +46,16 @@ def test_tail_period_equals_one_over_frequency(empty_scene, frequency, fps, peri
     y = frames(obj, range(1, 1 + 2 * period_frames + 1))[:, tail, 1]
     amplitude = 0.5 * (y.max() - y.min())
     # One period later the tail is back; half a period later it is on the other side.
-    assert np.abs(y[period_frames:2 * period_frames] - y[:period_frames]).max() < 1e-4 * amplitude + 1e-6
+    assert (
+        np.abs(y[period_frames : 2 * period_frames] - y[:period_frames]).max()
+        < 1e-4 * amplitude + 1e-6
+    )
     mean = 0.5 * (y.max() + y.min())
     half = period_frames // 2
-    assert np.abs((y[half:half + period_frames] - mean) + (y[:period_frames] - mean)).max() < 0.02 * amplitude
+    assert (
+        np.abs((y[half : half + period_frames] - mean) + (y[:period_frames] - mean)).max()
+        < 0.02 * amplitude
+    )
 
 
 def _ring_centroid_length(positions, rings=48, segments=24):
@@ -79,7 +87,7 @@ def test_wave_travels_from_head_to_tail(empty_scene):
     y = frames(obj, range(1, 97))
     peak_front = int(np.argmax(y[:48, front, 1]))
     # The back point peaks later (within the next beat) than the front point.
-    lag = (int(np.argmax(y[peak_front:peak_front + 48, back, 1])))
+    lag = int(np.argmax(y[peak_front : peak_front + 48, back, 1]))
     assert 0 < lag < 48
     expected = (0.3 / 0.6) * 48  # distance / wavelength (0.6 L) of a beat at 48 frames per beat
     assert abs(lag - expected) < 8, (lag, expected)

@@ -23,7 +23,11 @@ CLASSES = (
 )
 
 PROPERTIES = (
-    (bpy.types.Object, "kodawari_swim", lambda: bpy.props.PointerProperty(type=props.KodawariSwimSettings)),
+    (
+        bpy.types.Object,
+        "kodawari_swim",
+        lambda: bpy.props.PointerProperty(type=props.KodawariSwimSettings),
+    ),
 )
 
 HANDLERS = (

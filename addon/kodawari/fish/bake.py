@@ -53,9 +53,11 @@ class Baker:
         self.original_frame = (scene.frame_current, scene.frame_subframe)
         self.index = 0
         self.handle = None
-        self.keys = []          # SHAPE_KEYS: positions per frame, made into keys at the end
-        self.travel = []        # speed mode: the object's travel per frame
-        self.follow = runtime.path.follow_path(obj) if obj.kodawari_swim.speed_mode != "NONE" else None
+        self.keys = []  # SHAPE_KEYS: positions per frame, made into keys at the end
+        self.travel = []  # speed mode: the object's travel per frame
+        self.follow = (
+            runtime.path.follow_path(obj) if obj.kodawari_swim.speed_mode != "NONE" else None
+        )
 
     @property
     def done(self):
@@ -70,7 +72,8 @@ class Baker:
             folder = os.path.dirname(self.absolute_path)
             if folder:
                 os.makedirs(folder, exist_ok=True)
-            self.handle = open(self.absolute_path + ".part", "wb")
+            # Stays open across the modal bake's steps; closed by finish() or cancel().
+            self.handle = open(self.absolute_path + ".part", "wb")  # noqa: SIM115
             count = len(self.obj.data.vertices)
             self.handle.write(pc2_header(count, self.frames[0], 1.0, len(self.frames)))
 
@@ -84,7 +87,9 @@ class Baker:
             self.keys.append(positions.copy())
         settings = self.obj.kodawari_swim
         if settings.speed_mode != "NONE":
-            self.travel.append(self.follow.offset_factor if self.follow else tuple(self.obj.delta_location))
+            self.travel.append(
+                self.follow.offset_factor if self.follow else tuple(self.obj.delta_location)
+            )
         self.index += 1
 
     def _restore_frame(self):
@@ -98,9 +103,8 @@ class Baker:
             os.remove(self.absolute_path + ".part")
         self.keys = []
         settings = self.obj.kodawari_swim
-        if settings.speed_mode != "NONE":
-            if self.follow is None:
-                self.obj.delta_location = settings.rest_delta_location
+        if settings.speed_mode != "NONE" and self.follow is None:
+            self.obj.delta_location = settings.rest_delta_location
         self._restore_frame()
 
     def finish(self):
@@ -111,7 +115,9 @@ class Baker:
             self.handle.close()
             self.handle = None
             os.replace(self.absolute_path + ".part", self.absolute_path)
-            modifier = obj.modifiers.get(CACHE_MODIFIER) or obj.modifiers.new(CACHE_MODIFIER, "MESH_CACHE")
+            modifier = obj.modifiers.get(CACHE_MODIFIER) or obj.modifiers.new(
+                CACHE_MODIFIER, "MESH_CACHE"
+            )
             modifier.cache_format = "PC2"
             modifier.filepath = self.filepath
             modifier.time_mode = "FRAME"
@@ -133,7 +139,9 @@ class Baker:
                 # On at its frame, off at the neighbours: linear keys blend subframes.
                 frames = [f for f in (frame - 1, frame, frame + 1) if first <= f <= last]
                 values = [1.0 if f == frame else 0.0 for f in frames]
-                fcurves.write_channels(action, key, f'key_blocks["{baked.name}"].value', frames, values)
+                fcurves.write_channels(
+                    action, key, f'key_blocks["{baked.name}"].value', frames, values
+                )
             self.keys = []
         if self.travel:
             action = fcurves.ensure_action(obj, obj.name + "Action")
@@ -142,8 +150,14 @@ class Baker:
                 path = f'constraints["{self.follow.name}"].offset_factor'
             else:
                 path = "delta_location"
-            fcurves.write_channels(action, obj, path, np.array(self.frames, dtype=np.float32), values,
-                                   group="Kodawari Swim")
+            fcurves.write_channels(
+                action,
+                obj,
+                path,
+                np.array(self.frames, dtype=np.float32),
+                values,
+                group="Kodawari Swim",
+            )
         if block is not None:
             block.value = 0.0
         settings.baked = self.target

@@ -12,8 +12,8 @@ import numpy as np
 from mathutils import Vector
 from mathutils.bvhtree import BVHTree
 
-THIN = 0.03          # fin plates are thinner than this fraction of body length
-CORE_FACTOR = 1.05   # and stand farther out than the core radius of their cross-section
+THIN = 0.03  # fin plates are thinner than this fraction of body length
+CORE_FACTOR = 1.05  # and stand farther out than the core radius of their cross-section
 MIN_FIN_VERTICES = 8
 SLICES = 24
 
@@ -75,7 +75,9 @@ def find_fins(obj, rig):
     for b in range(SLICES):
         solid = (slice_index == b) & ~thin
         if solid.any():
-            core[b] = float(np.median(radius[solid])) if solid.sum() > 3 else float(radius[solid].max())
+            core[b] = (
+                float(np.median(radius[solid])) if solid.sum() > 3 else float(radius[solid].max())
+            )
     candidate = thin & (radius > CORE_FACTOR * core[slice_index])
     up_part = offset @ rig.up
     side_part = offset @ rig.side

@@ -21,13 +21,15 @@ class FinPart:
 
     def __init__(self, fin_index, indices, weights, rest, axis, frame, root, amplitude_scale, kn):
         self.fin_index = fin_index
-        self.indices = indices          # int64 (M,) vertex indices into the mesh
-        self.weights = weights          # float32 (M, 1) group weight × root blend
-        self.rest = rest                # float32 (M, 3) rest positions
-        self.axis = axis                # float64 (m, 3) rest control axis
+        self.indices = indices  # int64 (M,) vertex indices into the mesh
+        self.weights = weights  # float32 (M, 1) group weight × root blend
+        self.rest = rest  # float32 (M, 3) rest positions
+        self.axis = axis  # float64 (m, 3) rest control axis
         self.tangent, self.side, self.up = frame
-        self.root = root                # float64 (3,) where the fin meets the body
-        self.amplitude_scale = amplitude_scale  # UNDULATE: fin height / base length (amplitude is per height)
+        self.root = root  # float64 (3,) where the fin meets the body
+        self.amplitude_scale = (
+            amplitude_scale  # UNDULATE: fin height / base length (amplitude is per height)
+        )
         self.binding = kn.ffd_bind(axis, rest, up=_up_hint(axis, self.up, self.side))
         self.feather_on_power, self.feather_sign = _blade_facing(rest, axis, frame, kn)
         self.out = np.empty_like(rest)
@@ -134,7 +136,11 @@ def build_parts(fin_index, fin, group_weights, verts, body_axis, up, kn, body_po
         # How far out each vertex is: its distance from the body where the fin has body
         # vertices around it (so the root row, on the body, is exactly 0), else its
         # reach along the fin kind's outward direction.
-        reach = distance_from_body(points, body_points) if body_points is not None and len(body_points) else None
+        reach = (
+            distance_from_body(points, body_points)
+            if body_points is not None and len(body_points)
+            else None
+        )
         if reach is None:
             reach = (points - centroid) @ _outward(fin.kind, centroid - axis_point, frame)
         lo, hi = float(reach.min()), float(reach.max())
@@ -157,11 +163,24 @@ def build_parts(fin_index, fin, group_weights, verts, body_axis, up, kn, body_po
             amplitude_scale = 1.0
             tip = tip_set.mean(axis=0)
             if np.linalg.norm(tip - root) < 1e-6:
-                raise ValueError(f"vertex group '{fin.vertex_group}' has no length from root to tip")
+                raise ValueError(
+                    f"vertex group '{fin.vertex_group}' has no length from root to tip"
+                )
             axis = root[None, :] + np.array(ROOT_CLUSTER)[:, None] * (tip - root)[None, :]
         blend = _smoothstep(r / max(fin.root_blend, 1e-3))
         weights = (group_weights[part_indices] * blend).astype(np.float32)[:, None]
         rest = np.ascontiguousarray(verts[part_indices], dtype=np.float32)
-        parts.append(FinPart(fin_index, part_indices, weights, rest, np.ascontiguousarray(axis), frame,
-                             root, amplitude_scale, kn))
+        parts.append(
+            FinPart(
+                fin_index,
+                part_indices,
+                weights,
+                rest,
+                np.ascontiguousarray(axis),
+                frame,
+                root,
+                amplitude_scale,
+                kn,
+            )
+        )
     return parts

@@ -8,12 +8,21 @@ bounding-box line (the issue's "User flow").
 import numpy as np
 
 AXES = {
-    "POS_X": (1.0, 0.0, 0.0), "NEG_X": (-1.0, 0.0, 0.0),
-    "POS_Y": (0.0, 1.0, 0.0), "NEG_Y": (0.0, -1.0, 0.0),
-    "POS_Z": (0.0, 0.0, 1.0), "NEG_Z": (0.0, 0.0, -1.0),
+    "POS_X": (1.0, 0.0, 0.0),
+    "NEG_X": (-1.0, 0.0, 0.0),
+    "POS_Y": (0.0, 1.0, 0.0),
+    "NEG_Y": (0.0, -1.0, 0.0),
+    "POS_Z": (0.0, 0.0, 1.0),
+    "NEG_Z": (0.0, 0.0, -1.0),
 }
-OPPOSITE = {"POS_X": "NEG_X", "NEG_X": "POS_X", "POS_Y": "NEG_Y", "NEG_Y": "POS_Y",
-            "POS_Z": "NEG_Z", "NEG_Z": "POS_Z"}
+OPPOSITE = {
+    "POS_X": "NEG_X",
+    "NEG_X": "POS_X",
+    "POS_Y": "NEG_Y",
+    "NEG_Y": "POS_Y",
+    "POS_Z": "NEG_Z",
+    "NEG_Z": "POS_Z",
+}
 LABEL = {"POS_X": "+X", "NEG_X": "-X", "POS_Y": "+Y", "NEG_Y": "-Y", "POS_Z": "+Z", "NEG_Z": "-Z"}
 
 
@@ -38,7 +47,7 @@ def _slice_sizes(verts, axis_index, bins):
     ends = np.searchsorted(sorted_index, np.arange(bins), side="right")
     for b in range(bins):
         if ends[b] > starts[b]:
-            chunk = verts[order[starts[b]:ends[b]]][:, others]
+            chunk = verts[order[starts[b] : ends[b]]][:, others]
             extent = chunk.max(axis=0) - chunk.min(axis=0)
             sizes[b] = float(extent[0]) * float(extent[1])
     return sizes
@@ -58,8 +67,10 @@ def guess_head_axis(verts):
     positive = bias > 0.5
     name = ("POS_" if positive else "NEG_") + "XYZ"[axis_index]
     confidence = "clearly" if abs(bias - 0.5) > 0.03 else "only slightly (check it)"
-    reason = (f"head guessed along {LABEL[name]}: the body is longest along {'XYZ'[axis_index]} and "
-              f"{confidence} thicker toward that end; flip Head Axis if the fish swims backward")
+    reason = (
+        f"head guessed along {LABEL[name]}: the body is longest along {'XYZ'[axis_index]} and "
+        f"{confidence} thicker toward that end; flip Head Axis if the fish swims backward"
+    )
     return name, reason
 
 
@@ -71,9 +82,13 @@ def midline_points(verts, head_axis, count, slices=None):
     lo, hi = float(along.min()), float(along.max())
     length = hi - lo
     slices = slices or max(4 * count, 32)
-    index = np.minimum(((hi - along) / max(length, 1e-12) * slices).astype(np.int64), slices - 1)  # 0 = snout
+    index = np.minimum(
+        ((hi - along) / max(length, 1e-12) * slices).astype(np.int64), slices - 1
+    )  # 0 = snout
     counts = np.bincount(index, minlength=slices).astype(np.float64)
-    sums = np.stack([np.bincount(index, weights=v[:, c], minlength=slices) for c in range(3)], axis=1)
+    sums = np.stack(
+        [np.bincount(index, weights=v[:, c], minlength=slices) for c in range(3)], axis=1
+    )
     filled = counts > 0
     centroids = np.zeros((slices, 3))
     centroids[filled] = sums[filled] / counts[filled, None]

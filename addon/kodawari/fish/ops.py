@@ -1,5 +1,8 @@
 """Operators: add / remove the swim, add / find fins, flip the head, bake."""
 
+# bl_options sets are Blender's class-attribute convention, never mutated.
+# ruff: noqa: RUF012
+
 import os
 import types
 
@@ -17,7 +20,11 @@ SHAPE_KEY = rig_module.SHAPE_KEY
 
 
 def _active_mesh(context):
-    return context.active_object if context.active_object is not None else getattr(context, "object", None)
+    return (
+        context.active_object
+        if context.active_object is not None
+        else getattr(context, "object", None)
+    )
 
 
 class KODAWARI_OT_swim_add(bpy.types.Operator):
@@ -32,15 +39,24 @@ class KODAWARI_OT_swim_add(bpy.types.Operator):
         items=[("AUTO", "Auto", "Guess from the shape (reported)")] + list(HEAD_AXES),
         default="AUTO",
     )
-    preset: EnumProperty(name="Preset", items=[(k, *presets.LABELS[k]) for k in presets.ORDER],
-                         default="CARANGIFORM")
-    frequency: FloatProperty(name="Frequency", description="Tail beats per second (0: the preset's)",
-                             default=0.0)
+    preset: EnumProperty(
+        name="Preset", items=[(k, *presets.LABELS[k]) for k in presets.ORDER], default="CARANGIFORM"
+    )
+    frequency: FloatProperty(
+        name="Frequency", description="Tail beats per second (0: the preset's)", default=0.0
+    )
 
     def execute(self, context):
         obj = _active_mesh(context)
-        if obj is not None and obj.type == "MESH" and (obj.kodawari_swim.enabled or obj.kodawari_swim.baked != "NONE"
-                                                        or runtime.swim_key_block(obj) is not None):
+        if (
+            obj is not None
+            and obj.type == "MESH"
+            and (
+                obj.kodawari_swim.enabled
+                or obj.kodawari_swim.baked != "NONE"
+                or runtime.swim_key_block(obj) is not None
+            )
+        ):
             error = f"'{obj.name}' already swims: tune it in the Modifier tab, or remove it first"
         else:
             error = validate.swim_target(obj) or validate.frequency(self.frequency)
@@ -51,10 +67,14 @@ class KODAWARI_OT_swim_add(bpy.types.Operator):
         if self.head_axis == "AUTO":
             head_axis, guess = midline.guess_head_axis(rest)
         else:
-            head_axis, guess = self.head_axis, f"head axis {midline.LABEL[self.head_axis]} (as given)"
+            head_axis, guess = (
+                self.head_axis,
+                f"head axis {midline.LABEL[self.head_axis]} (as given)",
+            )
         # Bind once on trial before anything changes: a degenerate mesh fails here.
-        trial = types.SimpleNamespace(head_axis=head_axis, control_points=obj.kodawari_swim.control_points,
-                                      fins=[])
+        trial = types.SimpleNamespace(
+            head_axis=head_axis, control_points=obj.kodawari_swim.control_points, fins=[]
+        )
         try:
             rig_module.SwimRig(obj, trial)
         except ValueError as exc:
@@ -79,7 +99,9 @@ class KODAWARI_OT_swim_add(bpy.types.Operator):
         context.scene.render.use_lock_interface = True
         runtime.forget(obj)
         runtime.evaluate(obj, context.scene)
-        self.report({"INFO"}, f"Fish Swim on '{obj.name}': {guess}; preset {presets.LABELS[self.preset][0]}")
+        self.report(
+            {"INFO"}, f"Fish Swim on '{obj.name}': {guess}; preset {presets.LABELS[self.preset][0]}"
+        )
         return {"FINISHED"}
 
 
@@ -92,7 +114,11 @@ def remove_swim(obj):
         obj.modifiers.remove(modifier)
     keys = obj.data.shape_keys
     if keys is not None:
-        for block in [b for b in keys.key_blocks if b.name == SHAPE_KEY or b.name.startswith(bake.BAKED_KEY_PREFIX)]:
+        for block in [
+            b
+            for b in keys.key_blocks
+            if b.name == SHAPE_KEY or b.name.startswith(bake.BAKED_KEY_PREFIX)
+        ]:
             obj.shape_key_remove(block)
         keys = obj.data.shape_keys
         if keys is not None and len(keys.key_blocks) == 1:
@@ -122,7 +148,11 @@ class KODAWARI_OT_swim_remove(bpy.types.Operator):
             self.report({"ERROR"}, "Select the swimming mesh object first")
             return {"CANCELLED"}
         settings = obj.kodawari_swim
-        if not settings.enabled and settings.baked == "NONE" and runtime.swim_key_block(obj) is None:
+        if (
+            not settings.enabled
+            and settings.baked == "NONE"
+            and runtime.swim_key_block(obj) is None
+        ):
             self.report({"ERROR"}, f"'{obj.name}' has no Fish Swim to remove")
             return {"CANCELLED"}
         with runtime.batch(obj):
@@ -142,14 +172,18 @@ def _check_fin(obj, group_name, kind):
         return error, None
     settings = obj.kodawari_swim
     motion = presets.fin_defaults(settings.preset, kind)[0]
-    trial = types.SimpleNamespace(vertex_group=group_name, kind=kind, motion=motion, root_blend=0.35)
+    trial = types.SimpleNamespace(
+        vertex_group=group_name, kind=kind, motion=motion, root_blend=0.35
+    )
     try:
         rig = runtime.get_rig(obj)
         in_fin = weights > 0
         for fin in settings.fins:
             in_fin |= bulk.vertex_group_weights(obj, fin.vertex_group) > 0
         body_points = rig.rest[~in_fin].astype(np.float64)
-        fin_setup.build_parts(0, trial, weights, rig.rest, rig.axis_rest, rig.up, native.module(), body_points)
+        fin_setup.build_parts(
+            0, trial, weights, rig.rest, rig.axis_rest, rig.up, native.module(), body_points
+        )
     except ValueError as exc:
         return f"Cannot bind fin '{group_name}': {exc}", None
     return None, weights
@@ -211,7 +245,9 @@ class KODAWARI_OT_swim_fin_add(bpy.types.Operator):
             self.report({"ERROR"}, error)
             return {"CANCELLED"}
         add_fin(obj, self.vertex_group, self.kind)
-        self.report({"INFO"}, f"Fin '{self.vertex_group}' ({self.kind.lower()}) added to '{obj.name}'")
+        self.report(
+            {"INFO"}, f"Fin '{self.vertex_group}' ({self.kind.lower()}) added to '{obj.name}'"
+        )
         return {"FINISHED"}
 
 
@@ -256,7 +292,9 @@ class KODAWARI_OT_swim_fin_find(bpy.types.Operator):
         rig = runtime.get_rig(obj)
         found = finder.find_fins(obj, rig)
         if not found:
-            self.report({"WARNING"}, f"No fins found on '{obj.name}': no thin parts stand out from the body")
+            self.report(
+                {"WARNING"}, f"No fins found on '{obj.name}': no thin parts stand out from the body"
+            )
             return {"CANCELLED"}
         added = []
         for name, kind, indices in found:
@@ -297,15 +335,27 @@ class KODAWARI_OT_swim_bake(bpy.types.Operator):
     bl_label = "Bake Fish Swim"
     bl_options = {"REGISTER", "UNDO"}
 
-    frame_start: IntProperty(name="Start", description="First frame (unset: the scene's start)", default=1)
-    frame_end: IntProperty(name="End", description="Last frame (unset: the scene's end)", default=250)
+    frame_start: IntProperty(
+        name="Start", description="First frame (unset: the scene's start)", default=1
+    )
+    frame_end: IntProperty(
+        name="End", description="Last frame (unset: the scene's end)", default=250
+    )
     target: EnumProperty(
         name="Target",
-        items=[("MESH_CACHE", "Mesh Cache", "PC2 point cache beside the .blend, played by a Mesh Cache modifier"),
-               ("SHAPE_KEYS", "Shape Keys", "One shape key per frame, keyed on at its frame")],
+        items=[
+            (
+                "MESH_CACHE",
+                "Mesh Cache",
+                "PC2 point cache beside the .blend, played by a Mesh Cache modifier",
+            ),
+            ("SHAPE_KEYS", "Shape Keys", "One shape key per frame, keyed on at its frame"),
+        ],
         default="MESH_CACHE",
     )
-    filepath: StringProperty(name="File", description="PC2 file (empty: beside the .blend)", subtype="FILE_PATH")
+    filepath: StringProperty(
+        name="File", description="PC2 file (empty: beside the .blend)", subtype="FILE_PATH"
+    )
 
     _baker = None
     _timer = None
@@ -321,7 +371,9 @@ class KODAWARI_OT_swim_bake(bpy.types.Operator):
         if error is None and obj.kodawari_swim.baked != "NONE":
             error = f"'{obj.name}' is already baked: remove the swim to start again"
         if error is None and self.frame_end < self.frame_start:
-            error = f"The end frame {self.frame_end} comes before the start frame {self.frame_start}"
+            error = (
+                f"The end frame {self.frame_end} comes before the start frame {self.frame_start}"
+            )
         if error is None and self.target == "MESH_CACHE":
             path = self.filepath or bake.default_cache_path(obj)
             folder = os.path.dirname(bpy.path.abspath(path)) or "."
@@ -330,7 +382,9 @@ class KODAWARI_OT_swim_bake(bpy.types.Operator):
         if error:
             self.report({"ERROR"}, error)
             return None
-        path = (self.filepath or bake.default_cache_path(obj)) if self.target == "MESH_CACHE" else ""
+        path = (
+            (self.filepath or bake.default_cache_path(obj)) if self.target == "MESH_CACHE" else ""
+        )
         baker = bake.Baker(obj, context.scene, self.frame_start, self.frame_end, self.target, path)
         baker.start()
         return baker
@@ -376,7 +430,7 @@ class KODAWARI_OT_swim_bake(bpy.types.Operator):
         if event.type == "TIMER":
             try:
                 self._baker.step()
-            except Exception as exc:
+            except Exception as exc:  # noqa: BLE001 - any failure mid-bake is undone and reported
                 self._end(context)
                 self._baker.cancel()
                 self.report({"ERROR"}, f"Bake failed and was undone: {exc}")
@@ -384,7 +438,8 @@ class KODAWARI_OT_swim_bake(bpy.types.Operator):
             wm.progress_update(self._baker.index)
             if context.area:
                 context.area.header_text_set(
-                    f"Baking fish swim {self._baker.index}/{len(self._baker.frames)} (Esc cancels)")
+                    f"Baking fish swim {self._baker.index}/{len(self._baker.frames)} (Esc cancels)"
+                )
             if self._baker.done:
                 self._end(context)
                 self._baker.finish()
@@ -403,4 +458,3 @@ class KODAWARI_OT_swim_bake(bpy.types.Operator):
     def _done_message(baker):
         where = f"to {baker.filepath}" if baker.target == "MESH_CACHE" else "to shape keys"
         return f"Baked {len(baker.frames)} frames of '{baker.obj.name}' {where}; live evaluation is off"
-

@@ -14,7 +14,12 @@ CURVE_SAMPLES = 64
 def axis_polylines(obj):
     """World-space (curve points (K, 3), control points (n, 3)) of obj's current body axis,
     or None when it does not swim live."""
-    if obj is None or obj.type != "MESH" or not runtime.is_live(obj) or not obj.kodawari_swim.show_axis:
+    if (
+        obj is None
+        or obj.type != "MESH"
+        or not runtime.is_live(obj)
+        or not obj.kodawari_swim.show_axis
+    ):
         return None
     rig = runtime.get_rig(obj, build=False)
     if rig is None:
@@ -22,7 +27,7 @@ def axis_polylines(obj):
     kn = native.module()
     curve = kn.curve_points(rig.axis, np.linspace(0.0, 1.0, CURVE_SAMPLES))
     world = np.array(obj.matrix_world)
-    to_world = lambda p: p @ world[:3, :3].T + world[:3, 3]  # noqa: E731
+    to_world = lambda p: p @ world[:3, :3].T + world[:3, 3]
     return to_world(curve), to_world(rig.axis)
 
 

@@ -48,8 +48,11 @@ class KODAWARI_PT_swim(bpy.types.Panel):
             layout.operator("kodawari.swim_add", icon="MOD_WAVE")
             return
         if settings.baked != "NONE":
-            layout.label(text=f"Baked to {settings.baked.replace('_', ' ').title()}"
-                         + (f": {settings.cache_path}" if settings.baked == "MESH_CACHE" else ""), icon="CHECKMARK")
+            layout.label(
+                text=f"Baked to {settings.baked.replace('_', ' ').title()}"
+                + (f": {settings.cache_path}" if settings.baked == "MESH_CACHE" else ""),
+                icon="CHECKMARK",
+            )
             layout.operator("kodawari.swim_remove", icon="X")
             return
         layout.prop(settings, "preset")
@@ -80,7 +83,9 @@ class KODAWARI_PT_swim(bpy.types.Panel):
 
         layout.label(text="Fins")
         row = layout.row()
-        row.template_list("KODAWARI_UL_swim_fins", "", settings, "fins", settings, "fin_index", rows=3)
+        row.template_list(
+            "KODAWARI_UL_swim_fins", "", settings, "fins", settings, "fin_index", rows=3
+        )
         col = row.column(align=True)
         col.operator("kodawari.swim_fin_add", text="", icon="ADD")
         col.operator("kodawari.swim_fin_remove", text="", icon="REMOVE")

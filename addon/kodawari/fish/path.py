@@ -11,14 +11,24 @@ fish's own frame (forward = path tangent, up = world up made perpendicular).
 import bpy
 import numpy as np
 
-FORWARD = {"POS_X": "FORWARD_X", "NEG_X": "TRACK_NEGATIVE_X", "POS_Y": "FORWARD_Y", "NEG_Y": "TRACK_NEGATIVE_Y",
-           "POS_Z": "FORWARD_Z", "NEG_Z": "TRACK_NEGATIVE_Z"}
+FORWARD = {
+    "POS_X": "FORWARD_X",
+    "NEG_X": "TRACK_NEGATIVE_X",
+    "POS_Y": "FORWARD_Y",
+    "NEG_Y": "TRACK_NEGATIVE_Y",
+    "POS_Z": "FORWARD_Z",
+    "NEG_Z": "TRACK_NEGATIVE_Z",
+}
 
 
 def follow_path(obj):
     for constraint in obj.constraints:
-        if (constraint.type == "FOLLOW_PATH" and constraint.target is not None
-                and constraint.target.type == "CURVE" and not constraint.mute):
+        if (
+            constraint.type == "FOLLOW_PATH"
+            and constraint.target is not None
+            and constraint.target.type == "CURVE"
+            and not constraint.mute
+        ):
             return constraint
     return None
 
@@ -72,7 +82,9 @@ def place(obj, follow, head_axis, distance_world, points, arc):
         follow.use_curve_follow = True
     if not follow.use_fixed_location:
         follow.use_fixed_location = True
-    follow.offset_factor = float(np.clip(distance_world / arc[-1], 0.0, 1.0)) if arc[-1] > 0 else 0.0
+    follow.offset_factor = (
+        float(np.clip(distance_world / arc[-1], 0.0, 1.0)) if arc[-1] > 0 else 0.0
+    )
 
 
 def bent_rest_axis(rest_axis, head, up, side, scale, distance_world, points, arc):

@@ -12,31 +12,90 @@ import math
 BODY = {
     # Whole-body wave, λ ≈ 0.6 L, amplitude nearly uniform (eel, sea snake).
     # 16 control points: about 10 per wavelength, so the short wave stays smooth.
-    "ANGUILLIFORM": dict(frequency=1.2, wavelength=0.6, amplitude=0.08, amplitude_head=0.04,
-                         envelope_start=0.0, envelope_power=1.0, bend="LATERAL", control_points=16),
+    "ANGUILLIFORM": {
+        "frequency": 1.2,
+        "wavelength": 0.6,
+        "amplitude": 0.08,
+        "amplitude_head": 0.04,
+        "envelope_start": 0.0,
+        "envelope_power": 1.0,
+        "bend": "LATERAL",
+        "control_points": 16,
+    },
     # Rear third of the body plus caudal fin, λ ≈ 1 L, tail ≈ 0.1 L (jack, mackerel).
-    "CARANGIFORM": dict(frequency=2.0, wavelength=1.0, amplitude=0.1, amplitude_head=0.01,
-                        envelope_start=0.45, envelope_power=1.6, bend="LATERAL", control_points=8),
+    "CARANGIFORM": {
+        "frequency": 2.0,
+        "wavelength": 1.0,
+        "amplitude": 0.1,
+        "amplitude_head": 0.01,
+        "envelope_start": 0.45,
+        "envelope_power": 1.6,
+        "bend": "LATERAL",
+        "control_points": 8,
+    },
     # Stiff body: peduncle and tail only (tuna).
-    "THUNNIFORM": dict(frequency=2.5, wavelength=1.25, amplitude=0.09, amplitude_head=0.005,
-                       envelope_start=0.6, envelope_power=2.2, bend="LATERAL", control_points=8),
+    "THUNNIFORM": {
+        "frequency": 2.5,
+        "wavelength": 1.25,
+        "amplitude": 0.09,
+        "amplitude_head": 0.005,
+        "envelope_start": 0.6,
+        "envelope_power": 2.2,
+        "bend": "LATERAL",
+        "control_points": 8,
+    },
     # Rigid body, caudal fin only (boxfish): the body wave is off; the caudal fin flaps.
-    "OSTRACIIFORM": dict(frequency=2.0, wavelength=1.0, amplitude=0.0, amplitude_head=0.0,
-                         envelope_start=0.8, envelope_power=1.0, bend="LATERAL", control_points=8),
+    "OSTRACIIFORM": {
+        "frequency": 2.0,
+        "wavelength": 1.0,
+        "amplitude": 0.0,
+        "amplitude_head": 0.0,
+        "envelope_start": 0.8,
+        "envelope_power": 1.0,
+        "bend": "LATERAL",
+        "control_points": 8,
+    },
     # Body still, dorsal and anal fins undulate (filefish, triggerfish).
-    "BALISTIFORM": dict(frequency=2.0, wavelength=1.0, amplitude=0.0, amplitude_head=0.0,
-                        envelope_start=0.8, envelope_power=1.0, bend="LATERAL", control_points=8),
+    "BALISTIFORM": {
+        "frequency": 2.0,
+        "wavelength": 1.0,
+        "amplitude": 0.0,
+        "amplitude_head": 0.0,
+        "envelope_start": 0.8,
+        "envelope_power": 1.0,
+        "bend": "LATERAL",
+        "control_points": 8,
+    },
     # Body still, pectoral fins row (wrasse, porcupinefish).
-    "LABRIFORM": dict(frequency=1.5, wavelength=1.0, amplitude=0.0, amplitude_head=0.0,
-                      envelope_start=0.8, envelope_power=1.0, bend="LATERAL", control_points=8),
+    "LABRIFORM": {
+        "frequency": 1.5,
+        "wavelength": 1.0,
+        "amplitude": 0.0,
+        "amplitude_head": 0.0,
+        "envelope_start": 0.8,
+        "envelope_power": 1.0,
+        "bend": "LATERAL",
+        "control_points": 8,
+    },
     # Thunniform in the dorsoventral plane (dolphin, whale).
-    "CETACEAN": dict(frequency=1.5, wavelength=1.25, amplitude=0.09, amplitude_head=0.01,
-                     envelope_start=0.5, envelope_power=2.0, bend="DORSOVENTRAL", control_points=8),
+    "CETACEAN": {
+        "frequency": 1.5,
+        "wavelength": 1.25,
+        "amplitude": 0.09,
+        "amplitude_head": 0.01,
+        "envelope_start": 0.5,
+        "envelope_power": 2.0,
+        "bend": "DORSOVENTRAL",
+        "control_points": 8,
+    },
 }
 
 LABELS = {
     "ANGUILLIFORM": ("Anguilliform", "Whole-body wave, wavelength about 0.6 body lengths (eel)"),
-    "CARANGIFORM": ("Carangiform", "Rear third of the body and the tail, wavelength about 1 body length"),
+    "CARANGIFORM": (
+        "Carangiform",
+        "Rear third of the body and the tail, wavelength about 1 body length",
+    ),
     "THUNNIFORM": ("Thunniform", "Stiff body; peduncle and tail only (tuna)"),
     "OSTRACIIFORM": ("Ostraciiform", "Rigid body; only the caudal fin moves (boxfish)"),
     "BALISTIFORM": ("Balistiform", "Body still; dorsal and anal fins undulate (filefish)"),
@@ -44,7 +103,15 @@ LABELS = {
     "CETACEAN": ("Cetacean", "Thunniform in the dorsoventral plane (dolphin)"),
 }
 
-ORDER = ("ANGUILLIFORM", "CARANGIFORM", "THUNNIFORM", "OSTRACIIFORM", "BALISTIFORM", "LABRIFORM", "CETACEAN")
+ORDER = (
+    "ANGUILLIFORM",
+    "CARANGIFORM",
+    "THUNNIFORM",
+    "OSTRACIIFORM",
+    "BALISTIFORM",
+    "LABRIFORM",
+    "CETACEAN",
+)
 
 FIN_KINDS = ("PECTORAL", "DORSAL", "ANAL", "CAUDAL", "PELVIC")
 FIN_MOTIONS = ("FLAP", "UP_DOWN", "TWIST", "UNDULATE")
@@ -94,8 +161,9 @@ FIN_BY_PRESET = {
 def fin_defaults(preset, kind):
     """(motion, amplitude, phase_lag, feathering) of a new fin of `kind` under `preset`."""
     motion = FIN_MOTION_BY_KIND[kind]
-    amplitude, lag, feathering = FIN_BY_PRESET.get((preset, kind), (10 * _DEG if motion != "UNDULATE" else 0.3,
-                                                                     0.0, 0.0))
+    amplitude, lag, feathering = FIN_BY_PRESET.get(
+        (preset, kind), (10 * _DEG if motion != "UNDULATE" else 0.3, 0.0, 0.0)
+    )
     return motion, amplitude, lag, feathering
 
 

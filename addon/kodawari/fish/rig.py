@@ -12,7 +12,9 @@ from . import fins as fin_setup
 from . import midline
 
 SHAPE_KEY = "Kodawari Swim"
-PROBE_SCALE = 0.02  # probe arm length (fraction of body length) for the body's rotation at a fin root
+PROBE_SCALE = (
+    0.02  # probe arm length (fraction of body length) for the body's rotation at a fin root
+)
 
 
 def rest_positions(obj):
@@ -26,7 +28,9 @@ def rest_positions(obj):
 
 def binding_signature(obj, settings):
     """What the binding depends on; a change means rebuild."""
-    fins = tuple((f.vertex_group, f.kind, f.motion, round(f.root_blend, 6), f.enabled) for f in settings.fins)
+    fins = tuple(
+        (f.vertex_group, f.kind, f.motion, round(f.root_blend, 6), f.enabled) for f in settings.fins
+    )
     return (len(obj.data.vertices), settings.head_axis, settings.control_points, fins)
 
 
@@ -39,29 +43,47 @@ class SwimRig:
         self.rest = rest_positions(obj)
         self.count = len(self.rest)
         self.head, self.up, self.side = midline.body_frame(settings.head_axis)
-        self.axis_rest, self.body_length = midline.midline_points(self.rest, settings.head_axis,
-                                                                  settings.control_points)
+        self.axis_rest, self.body_length = midline.midline_points(
+            self.rest, settings.head_axis, settings.control_points
+        )
         self.binding = kn.ffd_bind(self.axis_rest, self.rest, up=self.up)
         self.positions = np.empty_like(self.rest)
         self.axis = self.axis_rest.copy()
         self.parts = []
-        weights = {f.vertex_group: bulk.vertex_group_weights(obj, f.vertex_group)
-                   for f in settings.fins if f.enabled}
+        weights = {
+            f.vertex_group: bulk.vertex_group_weights(obj, f.vertex_group)
+            for f in settings.fins
+            if f.enabled
+        }
         in_fin = np.zeros(self.count, dtype=bool)
         for w in weights.values():
             in_fin |= w > 0
         body_points = self.rest[~in_fin].astype(np.float64)
         for index, fin in enumerate(settings.fins):
             if fin.enabled:
-                self.parts.extend(fin_setup.build_parts(index, fin, weights[fin.vertex_group], self.rest,
-                                                        self.axis_rest, self.up, kn, body_points))
+                self.parts.extend(
+                    fin_setup.build_parts(
+                        index,
+                        fin,
+                        weights[fin.vertex_group],
+                        self.rest,
+                        self.axis_rest,
+                        self.up,
+                        kn,
+                        body_points,
+                    )
+                )
         # Four probe points per fin part (root and one step along its tangent, side, up):
         # deformed with the body they give the body's rotation at the root.
         arm = PROBE_SCALE * self.body_length
         probes = []
         for part in self.parts:
-            probes += [part.root, part.root + arm * part.tangent, part.root + arm * part.side,
-                       part.root + arm * part.up]
+            probes += [
+                part.root,
+                part.root + arm * part.tangent,
+                part.root + arm * part.side,
+                part.root + arm * part.up,
+            ]
         self.probe_arm = arm
         if probes:
             self.probes_rest = np.ascontiguousarray(probes, dtype=np.float32)
@@ -73,12 +95,18 @@ class SwimRig:
 
     def body_axis(self, settings, phase, rest_axis=None):
         return self.kn.swim_body_axis(
-            self.axis_rest if rest_axis is None else rest_axis, self.bend_direction(settings), self.body_length,
+            self.axis_rest if rest_axis is None else rest_axis,
+            self.bend_direction(settings),
+            self.body_length,
             phase,
-            wavelength=settings.wavelength, amplitude=settings.amplitude,
-            amplitude_head=settings.amplitude_head, envelope_start=settings.envelope_start,
-            envelope_power=settings.envelope_power, phase_offset=settings.phase_offset,
-            preserve_length=settings.preserve_length)
+            wavelength=settings.wavelength,
+            amplitude=settings.amplitude,
+            amplitude_head=settings.amplitude_head,
+            envelope_start=settings.envelope_start,
+            envelope_power=settings.envelope_power,
+            phase_offset=settings.phase_offset,
+            preserve_length=settings.preserve_length,
+        )
 
     def _root_rotations(self):
         """Rotation (3, 3) of the body at each fin part's root, rest → now."""
@@ -86,7 +114,7 @@ class SwimRig:
         rest = self.probes_rest.astype(np.float64).reshape(-1, 4, 3)
         rotations = []
         for k in range(len(p)):
-            moved = (p[k, 1:] - p[k, 0]).T      # columns: tangent, side, up after the bend
+            moved = (p[k, 1:] - p[k, 0]).T  # columns: tangent, side, up after the bend
             before = (rest[k, 1:] - rest[k, 0]).T
             # Nearest rotation to moved · before⁻¹ (polar decomposition by SVD).
             u, _, vt = np.linalg.svd(moved @ np.linalg.inv(before))
@@ -113,10 +141,18 @@ class SwimRig:
                 continue
             fin_phase = phase * fin.frequency_ratio - fin.phase_lag
             points, twist = kn.swim_fin_axis(
-                part.axis, part.tangent, part.side, part.up, fin.motion, fin.amplitude * part.amplitude_scale,
+                part.axis,
+                part.tangent,
+                part.side,
+                part.up,
+                fin.motion,
+                fin.amplitude * part.amplitude_scale,
                 fin_phase,
-                feathering=fin.feathering * part.feather_sign, wavelength=fin.wavelength, fixed_count=3,
-                feather_on_power=part.feather_on_power)
+                feathering=fin.feathering * part.feather_sign,
+                wavelength=fin.wavelength,
+                fixed_count=3,
+                feather_on_power=part.feather_on_power,
+            )
             part.binding.deform(points, part.out, twist=twist)
             # The fin's own motion (rest space), turned with the body at its root and
             # faded in from the root: root vertices keep the body's position exactly.

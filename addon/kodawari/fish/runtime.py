@@ -14,9 +14,8 @@ import mathutils
 from bpy.app.handlers import persistent
 
 from .. import bulk
-from . import path
+from . import path, timing
 from . import rig as rig_module
-from . import timing
 
 SHAPE_KEY = rig_module.SHAPE_KEY
 
@@ -39,8 +38,10 @@ def get_rig(obj, build=True):
     """The object's bound rig, rebuilt when its binding inputs changed."""
     settings = obj.kodawari_swim
     rig = _rigs.get(_key(obj))
-    if rig is not None and (rig.signature != rig_module.binding_signature(obj, settings)
-                            or rig.mesh_pointer != obj.data.as_pointer()):
+    if rig is not None and (
+        rig.signature != rig_module.binding_signature(obj, settings)
+        or rig.mesh_pointer != obj.data.as_pointer()
+    ):
         rig = None
     if rig is None and build:
         rig = rig_module.SwimRig(obj, settings)
@@ -67,8 +68,13 @@ def swim_key_block(obj):
 
 
 def is_live(obj):
-    return (obj is not None and obj.type == "MESH" and obj.kodawari_swim.enabled
-            and obj.kodawari_swim.baked == "NONE" and swim_key_block(obj) is not None)
+    return (
+        obj is not None
+        and obj.type == "MESH"
+        and obj.kodawari_swim.enabled
+        and obj.kodawari_swim.baked == "NONE"
+        and swim_key_block(obj) is not None
+    )
 
 
 def travel_direction(obj, rig):
@@ -97,8 +103,9 @@ def evaluate(obj, scene, frame=None):
         points, arc = path.polyline(follow.target)
         start = float(settings.path_start) * arc[-1]
         path.place(obj, follow, settings.head_axis, start + distance * scale, points, arc)
-        rest_axis = path.bent_rest_axis(rig.axis_rest, rig.head, rig.up, rig.side, scale,
-                                        start + distance * scale, points, arc)
+        rest_axis = path.bent_rest_axis(
+            rig.axis_rest, rig.head, rig.up, rig.side, scale, start + distance * scale, points, arc
+        )
     elif settings.speed_mode != "NONE":
         apply_travel(obj, rig, distance)
     positions = rig.evaluate(settings, phase, rest_axis)

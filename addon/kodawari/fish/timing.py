@@ -61,7 +61,11 @@ def phase_and_distance(obj, settings, scene, frame, body_length):
         kn = native.module()
         amplitude = _values(obj, settings, "amplitude", frames)
         strouhal = _values(obj, settings, "strouhal", frames)
-        speed = np.array([kn.swim_speed(settings.speed_mode, body_length, f, a, s)
-                          for f, a, s in zip(frequency, amplitude, strouhal)])
+        speed = np.array(
+            [
+                kn.swim_speed(settings.speed_mode, body_length, f, a, s)
+                for f, a, s in zip(frequency, amplitude, strouhal)
+            ]
+        )
         distance = _integrate(speed, frames, fps)
     return phase, distance

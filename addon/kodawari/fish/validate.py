@@ -12,21 +12,29 @@ def swim_target(obj):
     if obj is None:
         return "Select a mesh object first (no active object)"
     if obj.type != "MESH":
-        return f"'{obj.name}' is a {obj.type.lower()}, not a mesh: Fish Swim deforms mesh objects only"
+        return (
+            f"'{obj.name}' is a {obj.type.lower()}, not a mesh: Fish Swim deforms mesh objects only"
+        )
     if obj.mode != "OBJECT":
         return f"'{obj.name}' is in {obj.mode.lower().replace('_', ' ')} mode: switch to Object Mode first"
     if len(obj.data.vertices) < MIN_VERTICES:
         return f"'{obj.name}' has {len(obj.data.vertices)} vertices; Fish Swim needs at least {MIN_VERTICES}"
     scale = tuple(obj.scale)
     if min(scale) <= 0:
-        return (f"'{obj.name}' has a negative or zero scale {tuple(round(s, 4) for s in scale)}: "
-                f"apply the scale (Ctrl+A) first")
+        return (
+            f"'{obj.name}' has a negative or zero scale {tuple(round(s, 4) for s in scale)}: "
+            f"apply the scale (Ctrl+A) first"
+        )
     if max(scale) - min(scale) > 1e-4 * max(abs(s) for s in scale):
-        return (f"'{obj.name}' has a non-uniform scale {tuple(round(s, 4) for s in scale)}: "
-                f"apply the scale (Ctrl+A) first so the body bends without shearing")
+        return (
+            f"'{obj.name}' has a non-uniform scale {tuple(round(s, 4) for s in scale)}: "
+            f"apply the scale (Ctrl+A) first so the body bends without shearing"
+        )
     if obj.data.shape_keys is not None:
-        return (f"'{obj.name}' already has shape keys: Fish Swim writes its own shape key on a clean mesh; "
-                f"apply or remove the existing ones first")
+        return (
+            f"'{obj.name}' already has shape keys: Fish Swim writes its own shape key on a clean mesh; "
+            f"apply or remove the existing ones first"
+        )
     if len(obj.modifiers):
         names = ", ".join(m.name for m in obj.modifiers)
         return f"'{obj.name}' has modifiers ({names}): apply or remove them before adding Fish Swim"
@@ -53,9 +61,14 @@ def fin_group(obj, group_name, existing_fins):
     if members == 0:
         return f"Vertex group '{group_name}' is empty: assign the fin's vertices to it first", None
     if members < MIN_VERTICES:
-        return f"Vertex group '{group_name}' has {members} vertices; a fin needs at least {MIN_VERTICES}", None
+        return (
+            f"Vertex group '{group_name}' has {members} vertices; a fin needs at least {MIN_VERTICES}",
+            None,
+        )
     share = members / len(weights)
     if share > MAX_FIN_SHARE:
-        return (f"Vertex group '{group_name}' covers {share:.0%} of the mesh: a fin must be a small part "
-                f"(at most {MAX_FIN_SHARE:.0%}), not the body"), None
+        return (
+            f"Vertex group '{group_name}' covers {share:.0%} of the mesh: a fin must be a small part "
+            f"(at most {MAX_FIN_SHARE:.0%}), not the body"
+        ), None
     return None, weights
