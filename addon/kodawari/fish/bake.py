@@ -119,7 +119,10 @@ class Baker:
                 CACHE_MODIFIER, "MESH_CACHE"
             )
             modifier.cache_format = "PC2"
-            modifier.filepath = self.filepath
+            # Relative to the .blend when it is saved, so the pair can move together.
+            modifier.filepath = (
+                bpy.path.relpath(self.absolute_path) if bpy.data.filepath else self.absolute_path
+            )
             modifier.time_mode = "FRAME"
             modifier.play_mode = "SCENE"
             modifier.frame_start = float(self.frames[0])
@@ -128,7 +131,7 @@ class Baker:
             modifier.interpolation = "LINEAR"
             if hasattr(obj.modifiers, "move"):
                 obj.modifiers.move(list(obj.modifiers).index(modifier), 0)
-            settings.cache_path = self.filepath
+            settings.cache_path = modifier.filepath
         else:
             key = obj.data.shape_keys
             first, last = self.frames[0], self.frames[-1]

@@ -68,9 +68,11 @@ def swim_key_block(obj):
 
 
 def is_live(obj):
+    # Not in Edit Mode: there the user edits the shape key, and leaving rewrites it.
     return (
         obj is not None
         and obj.type == "MESH"
+        and obj.mode != "EDIT"
         and obj.kodawari_swim.enabled
         and obj.kodawari_swim.baked == "NONE"
         and swim_key_block(obj) is not None
