@@ -4,7 +4,8 @@ and a Mesh Cache modifier); saves out/fish.blend and renders
 out/fish_sheet.png, a contact sheet with one row per fish — tuna (thunniform),
 eel (anguilliform), boxfish (ostraciiform), filefish (balistiform), pufferfish
 (labriform), dolphin (cetacean) — and eight columns: four frames a quarter tail
-beat apart seen from above, then the same four frames seen from the side.
+beat apart seen from above (tilted 30 degrees toward the viewer), then the same
+four frames seen from the side.
 Runs in Blender 3.4 via tools/run_demo.sh.
 """
 
@@ -103,7 +104,8 @@ def setup_render(scene):
     sun.data.energy = 4.0
     sun.rotation_euler = (math.radians(30), math.radians(-25), math.radians(15))
     scene.collection.objects.link(sun)
-    top = add_view(scene, "top", (0.0, 0.0, 0.0), 1.45)
+    # "Above" is tilted 30 degrees toward the viewer so vertical fins (caudal, dorsal) show too.
+    top = add_view(scene, "top", (math.radians(30), 0.0, 0.0), 1.45)
     side = add_view(scene, "side", (math.radians(90), 0.0, 0.0), 1.45)
     return top, side
 
@@ -111,7 +113,11 @@ def setup_render(scene):
 def aim(top, side, obj):
     """Frame one fish: the top camera above it, the side camera beside it."""
     x, y, z = obj.location
-    top.location = (x - 0.05, y, z + 5.0)
+    top.location = (
+        x - 0.05,
+        y - 5.0 * math.sin(math.radians(30)),
+        z + 5.0 * math.cos(math.radians(30)),
+    )
     side.location = (x - 0.05, y - 5.0, z)
 
 
