@@ -91,3 +91,23 @@ def test_wave_travels_from_head_to_tail(empty_scene):
     assert 0 < lag < 48
     expected = (0.3 / 0.6) * 48  # distance / wavelength (0.6 L) of a beat at 48 frames per beat
     assert abs(lag - expected) < 8, (lag, expected)
+
+
+def test_cetacean_bends_up_and_down_not_sideways(empty_scene):
+    set_fps(24)
+    obj = make_fish("dolphin")
+    add_swim(obj, head_axis="POS_X", preset="CETACEAN", frequency=1.5)
+    tail, _ = _tail_and_snout(obj)
+    motion = frames(obj, range(1, 17))[:, tail] - rest(obj)[tail]
+    assert np.ptp(motion[:, 2]) > 0.1 * body_length(obj)  # flukes beat up and down
+    assert np.ptp(motion[:, 1]) < 1e-4 * body_length(obj)  # and not sideways
+
+
+def test_anguilliform_moves_the_whole_body(empty_scene):
+    set_fps(24)
+    obj = make_fish("eel")
+    add_swim(obj, head_axis="POS_X", preset="ANGUILLIFORM", frequency=2.0)
+    tail, snout = _tail_and_snout(obj)
+    sideways = np.ptp(frames(obj, range(1, 13))[:, :, 1], axis=0)
+    # Nearly uniform amplitude: the snout swings at least a third as far as the tail.
+    assert sideways[snout] > 0.33 * sideways[tail]
