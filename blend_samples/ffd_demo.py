@@ -213,6 +213,9 @@ def main():
     png_path = os.path.join(OUT, "ffd_demo.png")
     render_sheet(scene, label, png_path)
     scene.frame_set(1)
+    for stale in (blend_path, blend_path + "1"):  # no .blend1 backup of an earlier run
+        if os.path.exists(stale):
+            os.remove(stale)
     bpy.ops.wm.save_as_mainfile(filepath=blend_path)
     print(f"ffd demo wrote {blend_path} and {png_path}")
 

@@ -35,6 +35,7 @@ def test_bent_positions_reach_the_evaluated_mesh_through_a_shape_key(empty_scene
     key = obj.shape_key_add(name="kodawari_ffd")
     key.value = 1.0
     bulk.set_shape_key_positions(key, out)
+    np.testing.assert_array_equal(bulk.shape_key_positions(key), out)
 
     depsgraph = bpy.context.evaluated_depsgraph_get()
     depsgraph.update()
