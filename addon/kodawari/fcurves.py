@@ -104,3 +104,13 @@ def write_channels(action, id_block, data_path, frames, values, group="", interp
         write_keys(fcurve, frames, np.ascontiguousarray(values[:, index]), interpolation)
         curves.append(fcurve)
     return curves
+
+
+def remove_fcurve(action, id_block, fcurve):
+    """Remove one F-curve of id_block from `action` (legacy or slotted)."""
+    if not _SLOTTED:
+        action.fcurves.remove(fcurve)
+        return
+    bag = _channelbag(action, id_block, create=False)
+    if bag is not None:
+        bag.fcurves.remove(fcurve)

@@ -1,0 +1,36 @@
+"""Fish swim: any fish mesh swims by bending along a control axis (SEEDS §1, issue 3).
+
+Object.kodawari_swim holds the settings; runtime.py evaluates on frame changes
+into the "Kodawari Swim" shape key; ops.py adds, tunes, bakes and removes.
+"""
+
+import bpy
+
+from . import ops, panel, props, runtime
+
+CLASSES = (
+    props.KodawariSwimFin,
+    props.KodawariSwimSettings,
+    ops.KODAWARI_OT_swim_add,
+    ops.KODAWARI_OT_swim_remove,
+    ops.KODAWARI_OT_swim_fin_add,
+    ops.KODAWARI_OT_swim_fin_remove,
+    ops.KODAWARI_OT_swim_fin_find,
+    ops.KODAWARI_OT_swim_flip_head,
+    ops.KODAWARI_OT_swim_bake,
+    panel.KODAWARI_UL_swim_fins,
+    panel.KODAWARI_PT_swim,
+)
+
+PROPERTIES = (
+    (
+        bpy.types.Object,
+        "kodawari_swim",
+        lambda: bpy.props.PointerProperty(type=props.KodawariSwimSettings),
+    ),
+)
+
+HANDLERS = (
+    ("frame_change_post", runtime.on_frame_change),
+    ("load_post", runtime.on_load),
+)

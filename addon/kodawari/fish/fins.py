@@ -1,0 +1,186 @@
+"""Fin set-up (SEEDS §1 "Fins"): a small control axis per fin, bound once.
+
+A fin's vertices come from a vertex group. Its axis runs root → tip with the
+first three of five control points clustered at the root (they stay fixed, so
+the fin never tears from the body); an undulating fin's axis runs along its base
+instead. Each fin vertex blends from the body's motion at the root to the fin's
+own motion further out, so root vertices move exactly with the body.
+"""
+
+import numpy as np
+from mathutils import kdtree
+
+# Seed: of 5 points, the first 3 close together near the root (fixed).
+ROOT_CLUSTER = (0.0, 0.05, 0.1, 0.55, 1.0)
+UNDULATE_POINTS = 7
+
+
+class FinPart:
+    """One side of one fin, bound to its own axis (a group holding a left and a
+    right pectoral fin becomes two parts that beat as mirror images)."""
+
+    def __init__(self, fin_index, indices, weights, rest, axis, frame, root, amplitude_scale, kn):
+        self.fin_index = fin_index
+        self.indices = indices  # int64 (M,) vertex indices into the mesh
+        self.weights = weights  # float32 (M, 1) group weight × root blend
+        self.rest = rest  # float32 (M, 3) rest positions
+        self.axis = axis  # float64 (m, 3) rest control axis
+        self.tangent, self.side, self.up = frame
+        self.root = root  # float64 (3,) where the fin meets the body
+        self.amplitude_scale = (
+            amplitude_scale  # UNDULATE: fin height / base length (amplitude is per height)
+        )
+        self.binding = kn.ffd_bind(axis, rest, up=_up_hint(axis, self.up, self.side))
+        self.feather_on_power, self.feather_sign = _blade_facing(rest, axis, frame, kn)
+        self.out = np.empty_like(rest)
+        self.shift = np.empty_like(rest)
+
+
+def _up_hint(axis, up, side):
+    direction = axis[-1] - axis[0]
+    direction = direction / np.linalg.norm(direction)
+    return up if abs(float(direction @ up)) < 0.9 else side
+
+
+def _blade_facing(rest, axis, frame, kn):
+    """(feather on the power stroke?, roll sign): compares the modelled blade's normal
+    (least-variance direction of its vertices) with the flap stroke direction."""
+    direction = axis[-1] - axis[0]
+    stroke = kn.swim_flap_stroke_direction(direction, *frame)
+    centred = rest.astype(np.float64) - rest.mean(axis=0)
+    normal = np.linalg.svd(centred, full_matrices=False)[2][-1]
+    facing = abs(float(normal @ stroke))
+    on_power = facing < 0.7  # modelled edge-on: roll it to face the stroke on the power stroke
+    # Roll toward the stroke direction (rotation about the fin axis, right-handed).
+    sign = 1.0 if float(np.cross(normal, stroke) @ direction) >= 0 else -1.0
+    return on_power, sign
+
+
+def _smoothstep(x):
+    x = np.clip(x, 0.0, 1.0)
+    return x * x * (3.0 - 2.0 * x)
+
+
+def body_frame_at(point, body_axis, up):
+    """Tailward tangent, side and up of the body axis (control polygon) nearest `point`."""
+    seg_start = body_axis[:-1]
+    seg = body_axis[1:] - seg_start
+    lengths2 = np.einsum("ij,ij->i", seg, seg)
+    t = np.clip(np.einsum("ij,ij->i", point - seg_start, seg) / lengths2, 0.0, 1.0)
+    closest = seg_start + t[:, None] * seg
+    k = int(np.argmin(np.linalg.norm(closest - point, axis=1)))
+    tangent = seg[k] / np.sqrt(lengths2[k])
+    u = up - (up @ tangent) * tangent
+    u = u / np.linalg.norm(u)
+    side = np.cross(tangent, u)
+    return (tangent, side, u), closest[k]
+
+
+def _outward(kind, centroid_offset, frame):
+    tangent, side, up = frame
+    if kind == "CAUDAL":
+        return tangent
+    if kind == "DORSAL":
+        return up
+    if kind == "ANAL":
+        return -up
+    across = centroid_offset - (centroid_offset @ tangent) * tangent
+    norm = np.linalg.norm(across)
+    if norm < 1e-9:
+        return side if kind == "PECTORAL" else -up
+    return across / norm
+
+
+def distance_from_body(points, body_points):
+    """Each fin point's distance to the nearest body vertex (body = vertices in no fin),
+    searched among the body vertices near the fin only."""
+    lo, hi = points.min(axis=0), points.max(axis=0)
+    margin = 0.25 * float(np.linalg.norm(hi - lo)) + 1e-9
+    near = body_points[np.all((body_points >= lo - margin) & (body_points <= hi + margin), axis=1)]
+    if len(near) == 0:
+        return None
+    tree = kdtree.KDTree(len(near))
+    for i, p in enumerate(near):
+        tree.insert(p, i)
+    tree.balance()
+    return np.array([tree.find(p)[2] for p in points])
+
+
+def split_sides(kind, points, axis_point, frame):
+    """Masks of the parts of a fin group: pectoral and pelvic groups holding both a
+    left and a right fin split by side; other kinds stay whole."""
+    whole = [np.ones(len(points), dtype=bool)]
+    if kind not in ("PECTORAL", "PELVIC"):
+        return whole
+    side_coord = (points - axis_point) @ frame[1]
+    left, right = side_coord > 0, side_coord <= 0
+    if min(left.sum(), right.sum()) >= max(3, 0.1 * len(points)):
+        return [left, right]
+    return whole
+
+
+def build_parts(fin_index, fin, group_weights, verts, body_axis, up, kn, body_points=None):
+    """FinParts of one fin setting; raises ValueError with a readable reason."""
+    indices = np.flatnonzero(group_weights > 0.0)
+    if len(indices) < 4:
+        raise ValueError(f"vertex group '{fin.vertex_group}' has fewer than 4 vertices")
+    points_all = verts[indices].astype(np.float64)
+    parts = []
+    centroid_all = points_all.mean(axis=0)
+    frame_all, axis_point_all = body_frame_at(centroid_all, body_axis, up)
+    for mask in split_sides(fin.kind, points_all, axis_point_all, frame_all):
+        points = points_all[mask]
+        part_indices = indices[mask]
+        centroid = points.mean(axis=0)
+        frame, axis_point = body_frame_at(centroid, body_axis, up)
+        # How far out each vertex is: its distance from the body where the fin has body
+        # vertices around it (so the root row, on the body, is exactly 0), else its
+        # reach along the fin kind's outward direction.
+        reach = (
+            distance_from_body(points, body_points)
+            if body_points is not None and len(body_points)
+            else None
+        )
+        if reach is None:
+            reach = (points - centroid) @ _outward(fin.kind, centroid - axis_point, frame)
+        lo, hi = float(reach.min()), float(reach.max())
+        if hi - lo < 1e-6:
+            raise ValueError(f"vertex group '{fin.vertex_group}' does not stand out from the body")
+        r = (reach - lo) / (hi - lo)  # 0 at the root, 1 at the fin's outer edge
+        root_set = points[r <= 0.1]
+        tip_set = points[r >= 0.9]
+        root = root_set.mean(axis=0)
+        if fin.motion == "UNDULATE":
+            along = (points - centroid) @ frame[0]
+            front, back = float(along.min()), float(along.max())
+            if back - front < 1e-6:
+                raise ValueError(f"vertex group '{fin.vertex_group}' has no length along the body")
+            middle = centroid - (centroid @ frame[0]) * frame[0]
+            stations = np.linspace(front, back, UNDULATE_POINTS) + centroid @ frame[0]
+            axis = middle[None, :] + stations[:, None] * frame[0][None, :]
+            amplitude_scale = (hi - lo) / (back - front)
+        else:
+            amplitude_scale = 1.0
+            tip = tip_set.mean(axis=0)
+            if np.linalg.norm(tip - root) < 1e-6:
+                raise ValueError(
+                    f"vertex group '{fin.vertex_group}' has no length from root to tip"
+                )
+            axis = root[None, :] + np.array(ROOT_CLUSTER)[:, None] * (tip - root)[None, :]
+        blend = _smoothstep(r / max(fin.root_blend, 1e-3))
+        weights = (group_weights[part_indices] * blend).astype(np.float32)[:, None]
+        rest = np.ascontiguousarray(verts[part_indices], dtype=np.float32)
+        parts.append(
+            FinPart(
+                fin_index,
+                part_indices,
+                weights,
+                rest,
+                np.ascontiguousarray(axis),
+                frame,
+                root,
+                amplitude_scale,
+                kn,
+            )
+        )
+    return parts

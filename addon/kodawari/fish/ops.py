@@ -1,0 +1,460 @@
+"""Operators: add / remove the swim, add / find fins, flip the head, bake."""
+
+# bl_options sets are Blender's class-attribute convention, never mutated.
+# ruff: noqa: RUF012
+
+import os
+import types
+
+import bpy
+import numpy as np
+from bpy.props import EnumProperty, FloatProperty, IntProperty, StringProperty
+
+from .. import bulk, fcurves, native
+from . import bake, finder, midline, presets, runtime, validate
+from . import fins as fin_setup
+from . import rig as rig_module
+from .props import HEAD_AXES
+
+SHAPE_KEY = rig_module.SHAPE_KEY
+
+
+def _active_mesh(context):
+    return (
+        context.active_object
+        if context.active_object is not None
+        else getattr(context, "object", None)
+    )
+
+
+class KODAWARI_OT_swim_add(bpy.types.Operator):
+    """Make the active mesh swim: bind it to a control axis along its mid-line"""
+
+    bl_idname = "kodawari.swim_add"
+    bl_label = "Add Fish Swim"
+    bl_options = {"REGISTER", "UNDO"}
+
+    head_axis: EnumProperty(
+        name="Head Axis",
+        items=[("AUTO", "Auto", "Guess from the shape (reported)")] + list(HEAD_AXES),
+        default="AUTO",
+    )
+    preset: EnumProperty(
+        name="Preset", items=[(k, *presets.LABELS[k]) for k in presets.ORDER], default="CARANGIFORM"
+    )
+    frequency: FloatProperty(
+        name="Frequency", description="Tail beats per second (0: the preset's)", default=0.0
+    )
+
+    def execute(self, context):
+        obj = _active_mesh(context)
+        if (
+            obj is not None
+            and obj.type == "MESH"
+            and (
+                obj.kodawari_swim.enabled
+                or obj.kodawari_swim.baked != "NONE"
+                or runtime.swim_key_block(obj) is not None
+            )
+        ):
+            error = f"'{obj.name}' already swims: tune it in the Modifier tab, or remove it first"
+        else:
+            error = validate.swim_target(obj) or validate.frequency(self.frequency)
+        if error:
+            self.report({"ERROR"}, error)
+            return {"CANCELLED"}
+        rest = bulk.vertex_positions(obj.data)
+        if self.head_axis == "AUTO":
+            head_axis, guess = midline.guess_head_axis(rest)
+        else:
+            head_axis, guess = (
+                self.head_axis,
+                f"head axis {midline.LABEL[self.head_axis]} (as given)",
+            )
+        # Bind once on trial before anything changes: a degenerate mesh fails here.
+        trial = types.SimpleNamespace(
+            head_axis=head_axis, control_points=obj.kodawari_swim.control_points, fins=[]
+        )
+        try:
+            rig_module.SwimRig(obj, trial)
+        except ValueError as exc:
+            self.report({"ERROR"}, f"Cannot bind '{obj.name}' to a swim axis: {exc}")
+            return {"CANCELLED"}
+
+        settings = obj.kodawari_swim
+        with runtime.batch(obj):
+            settings.head_axis = head_axis
+            settings.head_guess = guess
+            settings.preset = self.preset
+            presets.apply_body(settings, self.preset)
+            if self.frequency > 0:
+                settings.frequency = self.frequency
+            settings.rest_delta_location = obj.delta_location
+            settings.baked = "NONE"
+            obj.shape_key_add(name="Basis", from_mix=False)
+            key = obj.shape_key_add(name=SHAPE_KEY, from_mix=False)
+            key.value = 1.0
+            settings.enabled = True
+        # The handler writes the shape key on frame changes; renders must wait for it.
+        context.scene.render.use_lock_interface = True
+        runtime.forget(obj)
+        runtime.evaluate(obj, context.scene)
+        self.report(
+            {"INFO"}, f"Fish Swim on '{obj.name}': {guess}; preset {presets.LABELS[self.preset][0]}"
+        )
+        return {"FINISHED"}
+
+
+def remove_swim(obj):
+    """Undo everything swim_add, swim_fin_add and swim_bake did to the object."""
+    settings = obj.kodawari_swim
+    runtime.forget(obj)
+    modifier = obj.modifiers.get(bake.CACHE_MODIFIER)
+    if modifier is not None:
+        obj.modifiers.remove(modifier)
+    keys = obj.data.shape_keys
+    if keys is not None:
+        for block in [
+            b
+            for b in keys.key_blocks
+            if b.name == SHAPE_KEY or b.name.startswith(bake.BAKED_KEY_PREFIX)
+        ]:
+            obj.shape_key_remove(block)
+        keys = obj.data.shape_keys
+        if keys is not None and len(keys.key_blocks) == 1:
+            obj.shape_key_remove(keys.key_blocks[0])  # only the Basis we added is left
+    anim = obj.animation_data
+    if anim is not None and anim.action is not None:
+        for fcurve in fcurves.action_fcurves(anim.action, obj):
+            if fcurve.group is not None and fcurve.group.name == "Kodawari Swim":
+                fcurves.remove_fcurve(anim.action, obj, fcurve)
+    obj.delta_location = settings.rest_delta_location
+    settings.enabled = False
+    settings.baked = "NONE"
+    settings.fins.clear()
+    settings.head_guess = ""
+
+
+class KODAWARI_OT_swim_remove(bpy.types.Operator):
+    """Remove the swim and restore the original mesh exactly"""
+
+    bl_idname = "kodawari.swim_remove"
+    bl_label = "Remove Fish Swim"
+    bl_options = {"REGISTER", "UNDO"}
+
+    def execute(self, context):
+        obj = _active_mesh(context)
+        if obj is None or obj.type != "MESH":
+            self.report({"ERROR"}, "Select the swimming mesh object first")
+            return {"CANCELLED"}
+        settings = obj.kodawari_swim
+        if (
+            not settings.enabled
+            and settings.baked == "NONE"
+            and runtime.swim_key_block(obj) is None
+        ):
+            self.report({"ERROR"}, f"'{obj.name}' has no Fish Swim to remove")
+            return {"CANCELLED"}
+        with runtime.batch(obj):
+            remove_swim(obj)
+        self.report({"INFO"}, f"Fish Swim removed from '{obj.name}'; its mesh is as it was")
+        return {"FINISHED"}
+
+
+def _fin_kind_items():
+    return [(k, k.title(), f"{k.title()} fin") for k in presets.FIN_KINDS]
+
+
+def _check_fin(obj, group_name, kind):
+    """(error, None) or (None, weights) for a new fin, validated by binding it on trial."""
+    error, weights = validate.fin_group(obj, group_name, obj.kodawari_swim.fins)
+    if error:
+        return error, None
+    settings = obj.kodawari_swim
+    motion = presets.fin_defaults(settings.preset, kind)[0]
+    trial = types.SimpleNamespace(
+        vertex_group=group_name, kind=kind, motion=motion, root_blend=0.35
+    )
+    try:
+        rig = runtime.get_rig(obj)
+        in_fin = weights > 0
+        for fin in settings.fins:
+            in_fin |= bulk.vertex_group_weights(obj, fin.vertex_group) > 0
+        body_points = rig.rest[~in_fin].astype(np.float64)
+        fin_setup.build_parts(
+            0, trial, weights, rig.rest, rig.axis_rest, rig.up, native.module(), body_points
+        )
+    except ValueError as exc:
+        return f"Cannot bind fin '{group_name}': {exc}", None
+    return None, weights
+
+
+def add_fin(obj, group_name, kind):
+    settings = obj.kodawari_swim
+    motion, amplitude, lag, feathering = presets.fin_defaults(settings.preset, kind)
+    with runtime.batch(obj):
+        fin = settings.fins.add()
+        fin.name = group_name
+        fin.vertex_group = group_name
+        fin.kind = kind
+        fin.motion = motion
+        fin.amplitude = amplitude
+        fin.phase_lag = lag
+        fin.feathering = feathering
+        settings.fin_index = len(settings.fins) - 1
+    runtime.rebind(obj)
+    return fin
+
+
+def _needs_swim(obj):
+    if obj is None or obj.type != "MESH":
+        return "Select the swimming mesh object first"
+    if not obj.kodawari_swim.enabled or runtime.swim_key_block(obj) is None:
+        return f"'{obj.name}' does not swim yet: Add Fish Swim first"
+    return None
+
+
+class KODAWARI_OT_swim_fin_add(bpy.types.Operator):
+    """Add a fin whose vertices are a vertex group"""
+
+    bl_idname = "kodawari.swim_fin_add"
+    bl_label = "Add Fin"
+    bl_options = {"REGISTER", "UNDO"}
+
+    vertex_group: StringProperty(name="Vertex Group", description="The fin's vertices")
+    kind: EnumProperty(name="Kind", items=_fin_kind_items(), default="PECTORAL")
+
+    def invoke(self, context, event):
+        obj = _active_mesh(context)
+        if not self.vertex_group and obj is not None and obj.vertex_groups.active is not None:
+            self.vertex_group = obj.vertex_groups.active.name
+        return context.window_manager.invoke_props_dialog(self)
+
+    def draw(self, context):
+        obj = _active_mesh(context)
+        if obj is not None:
+            self.layout.prop_search(self, "vertex_group", obj, "vertex_groups")
+        self.layout.prop(self, "kind")
+
+    def execute(self, context):
+        obj = _active_mesh(context)
+        error = _needs_swim(obj)
+        if error is None:
+            error, _ = _check_fin(obj, self.vertex_group, self.kind)
+        if error:
+            self.report({"ERROR"}, error)
+            return {"CANCELLED"}
+        add_fin(obj, self.vertex_group, self.kind)
+        self.report(
+            {"INFO"}, f"Fin '{self.vertex_group}' ({self.kind.lower()}) added to '{obj.name}'"
+        )
+        return {"FINISHED"}
+
+
+class KODAWARI_OT_swim_fin_remove(bpy.types.Operator):
+    """Remove the active fin (its vertices follow the body again)"""
+
+    bl_idname = "kodawari.swim_fin_remove"
+    bl_label = "Remove Fin"
+    bl_options = {"REGISTER", "UNDO"}
+
+    index: IntProperty(name="Index", default=-1, description="Fin to remove (-1: the active one)")
+
+    def execute(self, context):
+        obj = _active_mesh(context)
+        error = _needs_swim(obj)
+        settings = obj.kodawari_swim if error is None else None
+        index = self.index if self.index >= 0 else (settings.fin_index if settings else -1)
+        if error is None and not 0 <= index < len(settings.fins):
+            error = f"'{obj.name}' has no fin number {index}"
+        if error:
+            self.report({"ERROR"}, error)
+            return {"CANCELLED"}
+        settings.fins.remove(index)
+        settings.fin_index = max(0, min(settings.fin_index, len(settings.fins) - 1))
+        runtime.rebind(obj)
+        return {"FINISHED"}
+
+
+class KODAWARI_OT_swim_fin_find(bpy.types.Operator):
+    """Find fins from the geometry (thin parts away from the body's core), make vertex groups and add them"""
+
+    bl_idname = "kodawari.swim_fin_find"
+    bl_label = "Find Fins"
+    bl_options = {"REGISTER", "UNDO"}
+
+    def execute(self, context):
+        obj = _active_mesh(context)
+        error = _needs_swim(obj)
+        if error:
+            self.report({"ERROR"}, error)
+            return {"CANCELLED"}
+        rig = runtime.get_rig(obj)
+        found = finder.find_fins(obj, rig)
+        if not found:
+            self.report(
+                {"WARNING"}, f"No fins found on '{obj.name}': no thin parts stand out from the body"
+            )
+            return {"CANCELLED"}
+        added = []
+        for name, kind, indices in found:
+            group = obj.vertex_groups.get(name) or obj.vertex_groups.new(name=name)
+            group.add([int(i) for i in indices], 1.0, "REPLACE")
+            if not any(f.vertex_group == name for f in obj.kodawari_swim.fins):
+                error, _ = _check_fin(obj, name, kind)
+                if error is None:
+                    add_fin(obj, name, kind)
+            added.append(f"{name} ({len(indices)} vertices)")
+        self.report({"INFO"}, f"Found {len(found)} fin(s) on '{obj.name}': " + ", ".join(added))
+        return {"FINISHED"}
+
+
+class KODAWARI_OT_swim_flip_head(bpy.types.Operator):
+    """Flip which end is the head (the fish swam backward)"""
+
+    bl_idname = "kodawari.swim_flip_head"
+    bl_label = "Flip Head"
+    bl_options = {"REGISTER", "UNDO"}
+
+    def execute(self, context):
+        obj = _active_mesh(context)
+        error = _needs_swim(obj)
+        if error:
+            self.report({"ERROR"}, error)
+            return {"CANCELLED"}
+        settings = obj.kodawari_swim
+        settings.head_axis = midline.OPPOSITE[settings.head_axis]
+        self.report({"INFO"}, f"Head now along {midline.LABEL[settings.head_axis]}")
+        return {"FINISHED"}
+
+
+class KODAWARI_OT_swim_bake(bpy.types.Operator):
+    """Bake the swim to a PC2 point cache (Mesh Cache modifier) or to shape keys"""
+
+    bl_idname = "kodawari.swim_bake"
+    bl_label = "Bake Fish Swim"
+    bl_options = {"REGISTER", "UNDO"}
+
+    frame_start: IntProperty(
+        name="Start", description="First frame (unset: the scene's start)", default=1
+    )
+    frame_end: IntProperty(
+        name="End", description="Last frame (unset: the scene's end)", default=250
+    )
+    target: EnumProperty(
+        name="Target",
+        items=[
+            (
+                "MESH_CACHE",
+                "Mesh Cache",
+                "PC2 point cache beside the .blend, played by a Mesh Cache modifier",
+            ),
+            ("SHAPE_KEYS", "Shape Keys", "One shape key per frame, keyed on at its frame"),
+        ],
+        default="MESH_CACHE",
+    )
+    filepath: StringProperty(
+        name="File", description="PC2 file (empty: beside the .blend)", subtype="FILE_PATH"
+    )
+
+    _baker = None
+    _timer = None
+
+    def _prepare(self, context):
+        # Unset frames mean the scene's range.
+        if not self.properties.is_property_set("frame_start"):
+            self.frame_start = context.scene.frame_start
+        if not self.properties.is_property_set("frame_end"):
+            self.frame_end = context.scene.frame_end
+        obj = _active_mesh(context)
+        error = _needs_swim(obj)
+        if error is None and obj.kodawari_swim.baked != "NONE":
+            error = f"'{obj.name}' is already baked: remove the swim to start again"
+        if error is None and self.frame_end < self.frame_start:
+            error = (
+                f"The end frame {self.frame_end} comes before the start frame {self.frame_start}"
+            )
+        if error is None and self.target == "MESH_CACHE":
+            path = self.filepath or bake.default_cache_path(obj)
+            folder = os.path.dirname(bpy.path.abspath(path)) or "."
+            if not os.path.isdir(folder) and not os.access(os.path.dirname(folder) or ".", os.W_OK):
+                error = f"Cannot write the cache into '{folder}'"
+        if error:
+            self.report({"ERROR"}, error)
+            return None
+        path = (
+            (self.filepath or bake.default_cache_path(obj)) if self.target == "MESH_CACHE" else ""
+        )
+        baker = bake.Baker(obj, context.scene, self.frame_start, self.frame_end, self.target, path)
+        baker.start()
+        return baker
+
+    def execute(self, context):
+        baker = self._prepare(context)
+        if baker is None:
+            return {"CANCELLED"}
+        wm = context.window_manager
+        wm.progress_begin(0, len(baker.frames))
+        try:
+            while not baker.done:
+                baker.step()
+                wm.progress_update(baker.index)
+            baker.finish()
+        except Exception:
+            baker.cancel()
+            raise
+        finally:
+            wm.progress_end()
+        self.report({"INFO"}, self._done_message(baker))
+        return {"FINISHED"}
+
+    def invoke(self, context, event):
+        if bpy.app.background:
+            return self.execute(context)
+        self._baker = self._prepare(context)
+        if self._baker is None:
+            return {"CANCELLED"}
+        wm = context.window_manager
+        wm.progress_begin(0, len(self._baker.frames))
+        self._timer = wm.event_timer_add(0.001, window=context.window)
+        wm.modal_handler_add(self)
+        return {"RUNNING_MODAL"}
+
+    def modal(self, context, event):
+        wm = context.window_manager
+        if event.type == "ESC":
+            self._end(context)
+            self._baker.cancel()
+            self.report({"WARNING"}, "Bake cancelled: nothing was changed")
+            return {"CANCELLED"}
+        if event.type == "TIMER":
+            try:
+                self._baker.step()
+            except Exception as exc:  # noqa: BLE001 - any failure mid-bake is undone and reported
+                self._end(context)
+                self._baker.cancel()
+                self.report({"ERROR"}, f"Bake failed and was undone: {exc}")
+                return {"CANCELLED"}
+            wm.progress_update(self._baker.index)
+            if context.area:
+                context.area.header_text_set(
+                    f"Baking fish swim {self._baker.index}/{len(self._baker.frames)} (Esc cancels)"
+                )
+            if self._baker.done:
+                self._end(context)
+                self._baker.finish()
+                self.report({"INFO"}, self._done_message(self._baker))
+                return {"FINISHED"}
+        return {"RUNNING_MODAL"}
+
+    def _end(self, context):
+        wm = context.window_manager
+        wm.event_timer_remove(self._timer)
+        wm.progress_end()
+        if context.area:
+            context.area.header_text_set(None)
+
+    @staticmethod
+    def _done_message(baker):
+        where = f"to {baker.filepath}" if baker.target == "MESH_CACHE" else "to shape keys"
+        return f"Baked {len(baker.frames)} frames of '{baker.obj.name}' {where}; live evaluation is off"

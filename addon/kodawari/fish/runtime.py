@@ -1,0 +1,160 @@
+"""Live evaluation: a frame_change_post handler writes each swimming object's
+deformed positions into its "Kodawari Swim" shape key; load_post drops the
+runtime state so it is rebuilt from the saved settings.
+
+Runtime state (the bound rigs) lives only in memory, keyed by object; anything
+that could make it stale (undo, a new file, changed binding settings, another
+mesh) is detected by a signature and the rig is rebuilt.
+"""
+
+import contextlib
+
+import bpy
+import mathutils
+from bpy.app.handlers import persistent
+
+from .. import bulk
+from . import path, timing
+from . import rig as rig_module
+
+SHAPE_KEY = rig_module.SHAPE_KEY
+
+_rigs = {}
+_batch_depth = {}
+
+
+def _key(obj):
+    return obj.as_pointer()
+
+
+def forget(obj=None):
+    if obj is None:
+        _rigs.clear()
+    else:
+        _rigs.pop(_key(obj), None)
+
+
+def get_rig(obj, build=True):
+    """The object's bound rig, rebuilt when its binding inputs changed."""
+    settings = obj.kodawari_swim
+    rig = _rigs.get(_key(obj))
+    if rig is not None and (
+        rig.signature != rig_module.binding_signature(obj, settings)
+        or rig.mesh_pointer != obj.data.as_pointer()
+    ):
+        rig = None
+    if rig is None and build:
+        rig = rig_module.SwimRig(obj, settings)
+        _rigs[_key(obj)] = rig
+    return rig
+
+
+@contextlib.contextmanager
+def batch(obj):
+    """Suspend per-property refreshes while several settings change together."""
+    key = _key(obj)
+    _batch_depth[key] = _batch_depth.get(key, 0) + 1
+    try:
+        yield
+    finally:
+        _batch_depth[key] -= 1
+        if not _batch_depth[key]:
+            del _batch_depth[key]
+
+
+def swim_key_block(obj):
+    keys = obj.data.shape_keys
+    return keys.key_blocks.get(SHAPE_KEY) if keys is not None else None
+
+
+def is_live(obj):
+    # Not in Edit Mode: there the user edits the shape key, and leaving rewrites it.
+    return (
+        obj is not None
+        and obj.type == "MESH"
+        and obj.mode != "EDIT"
+        and obj.kodawari_swim.enabled
+        and obj.kodawari_swim.baked == "NONE"
+        and swim_key_block(obj) is not None
+    )
+
+
+def travel_direction(obj, rig):
+    """Head direction in the object's parent space (object scale included)."""
+    return obj.matrix_basis.to_3x3() @ mathutils.Vector(rig.head)
+
+
+def apply_travel(obj, rig, distance):
+    """Advance the object along its head direction; returns nothing (see evaluate for paths)."""
+    rest = mathutils.Vector(obj.kodawari_swim.rest_delta_location)
+    obj.delta_location = rest + travel_direction(obj, rig) * distance
+
+
+def evaluate(obj, scene, frame=None):
+    """Deform one object for a frame (the scene's current frame by default); returns positions."""
+    settings = obj.kodawari_swim
+    rig = get_rig(obj)
+    if frame is None:
+        frame = scene.frame_current + scene.frame_subframe
+    phase, distance = timing.phase_and_distance(obj, settings, scene, frame, rig.body_length)
+    rest_axis = None
+    follow = path.follow_path(obj) if settings.speed_mode != "NONE" else None
+    if follow is not None:
+        # Along a curve: place the fish on it and bend the spine into its turns.
+        scale = float(obj.matrix_world.to_3x3().to_scale()[0])
+        points, arc = path.polyline(follow.target)
+        start = float(settings.path_start) * arc[-1]
+        path.place(obj, follow, settings.head_axis, start + distance * scale, points, arc)
+        rest_axis = path.bent_rest_axis(
+            rig.axis_rest, rig.head, rig.up, rig.side, scale, start + distance * scale, points, arc
+        )
+    elif settings.speed_mode != "NONE":
+        apply_travel(obj, rig, distance)
+    positions = rig.evaluate(settings, phase, rest_axis)
+    block = swim_key_block(obj)
+    if block is not None:
+        bulk.write_shape_key_positions(block, positions)
+    return positions
+
+
+def refresh(obj):
+    """Re-evaluate after a setting changed (no-op while batched or not live)."""
+    if _key(obj) in _batch_depth or not is_live(obj):
+        return
+    scene = bpy.context.scene
+    try:
+        evaluate(obj, scene)
+    except ValueError as exc:  # e.g. a fin group emptied by the user: say so, keep the last frame
+        print(f"Kodawari Swim: {obj.name}: {exc}")
+
+
+def rebind(obj):
+    forget(obj)
+    refresh(obj)
+
+
+@persistent
+def on_frame_change(scene, depsgraph=None):
+    for obj in scene.objects:
+        if obj.type != "MESH" or not is_live(obj):
+            continue
+        try:
+            evaluate(obj, scene)
+        except ValueError as exc:
+            print(f"Kodawari Swim: {obj.name}: {exc}")
+
+
+@persistent
+def on_load(_dummy=None, *_args):
+    # Rigs belong to the old file's objects; the first frame change rebuilds them
+    # from the saved settings. Evaluate now so the opened file shows the swim pose.
+    forget()
+    scene = bpy.context.scene
+    if scene is None:
+        return
+    for obj in scene.objects:
+        if obj.type == "MESH" and is_live(obj):
+            try:
+                evaluate(obj, scene)
+            except ValueError as exc:
+                print(f"Kodawari Swim: {obj.name}: {exc}")
