@@ -3,6 +3,7 @@
 One foreach_get/foreach_set per array: never a Python loop per vertex or bone.
 """
 
+import bpy
 import numpy as np
 
 
@@ -77,6 +78,7 @@ def pose_bone_matrices(pose_bones, out=None):
 # (element count, first and last positions); any mismatch falls back to foreach_set.
 _KEYBLOCK_TOTELEM_OFFSET = 32
 _KEYBLOCK_DATA_OFFSET = 40
+_KEYBLOCK_LAYOUT_VERSIONS = ((2, 80, 0), (4, 1, 0))
 
 
 def _shape_key_view(key_block, count):
@@ -101,9 +103,13 @@ def write_shape_key_positions(key_block, positions):
     tag its mesh for re-evaluation; returns True when the fast path was used."""
     count = len(key_block.data)
     positions = np.ascontiguousarray(positions, dtype=np.float32)
-    view = _shape_key_view(key_block, count) if count and positions.shape == (count, 3) else None
+    # Only where RNA has no raw path (before 4.1) and the layout above is known to hold;
+    # 4.1+ writes through ShapeKey.points at the same speed without touching memory.
+    raw_ok = _KEYBLOCK_LAYOUT_VERSIONS[0] <= bpy.app.version < _KEYBLOCK_LAYOUT_VERSIONS[1]
+    view = _shape_key_view(key_block, count) if raw_ok and count and positions.shape == (count, 3) else None
     if view is None:
         set_shape_key_positions(key_block, positions)
+        key_block.id_data.update_tag()
         return False
     np.copyto(view, positions)
     key_block.id_data.update_tag()
