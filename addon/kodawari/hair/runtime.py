@@ -21,6 +21,19 @@ NO_CAMERA = "No active camera: view keys fall back to the base shape"
 _runtimes = {}
 
 
+def active_camera(scene, frame):
+    """The camera of `frame`: markers bound to cameras decide (as Blender's camera switching
+    does: the last such marker at or before the frame, else the first one), else scene.camera.
+    Read here because scene.frame_set() switches the camera only after the frame handlers ran."""
+    markers = [m for m in scene.timeline_markers if m.camera is not None]
+    if not markers:
+        return scene.camera
+    before = [m for m in markers if m.frame <= frame]
+    if before:
+        return max(before, key=lambda m: m.frame).camera
+    return min(markers, key=lambda m: m.frame).camera
+
+
 class ArmatureRuntime:
     def __init__(self, obj):
         from . import props
@@ -82,11 +95,11 @@ class ArmatureRuntime:
         self.last_frame = None
 
     # -- one frame -------------------------------------------------------------
-    def _inputs(self, obj, scene):
+    def _inputs(self, obj, scene, frame):
         pose_bones = obj.pose.bones
         pose_bones.foreach_get("matrix", self.matrices.reshape(-1))
         pose_bones.foreach_get("rotation_quaternion", self.rotations.reshape(-1))
-        camera = scene.camera
+        camera = active_camera(scene, frame)
         self.status = "" if camera is not None else NO_CAMERA
         camera_position = None if camera is None else np.array(camera.matrix_world.translation, np.float64)
         gravity = np.array(scene.gravity if scene.use_gravity else (0.0, 0.0, 0.0), np.float64)
@@ -112,11 +125,11 @@ class ArmatureRuntime:
             if self.last_frame != frame:
                 self.system.load_state(cached[0])
             self.last_frame = frame
-            self.status = "" if scene.camera is not None else NO_CAMERA
+            self.status = "" if active_camera(scene, frame) is not None else NO_CAMERA
             self._write(obj, cached[1])
             return
         fps = scene.render.fps / scene.render.fps_base
-        armature_matrix, camera, gravity = self._inputs(obj, scene)
+        armature_matrix, camera, gravity = self._inputs(obj, scene, frame)
         earlier = [f for f in self.cache if f < frame]
         if frame <= scene.frame_start or not earlier:
             self.cache.clear()
