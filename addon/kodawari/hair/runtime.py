@@ -103,7 +103,7 @@ class ArmatureRuntime:
         self.status = "" if camera is not None else NO_CAMERA
         camera_position = None if camera is None else np.array(camera.matrix_world.translation, np.float64)
         gravity = np.array(scene.gravity if scene.use_gravity else (0.0, 0.0, 0.0), np.float64)
-        armature_matrix = np.array(obj.matrix_world, np.float64)
+        armature_matrix = np.array([tuple(row) for row in obj.matrix_world], np.float64)
         return armature_matrix, camera_position, gravity
 
     def _write(self, obj, rod_rotations):
