@@ -34,6 +34,11 @@ def active_camera(scene, frame):
     return min(markers, key=lambda m: m.frame).camera
 
 
+def _tag(obj):
+    """foreach_set bypasses RNA updates: tag the armature so its pose is re-evaluated."""
+    obj.update_tag(refresh={"DATA"})
+
+
 class ArmatureRuntime:
     def __init__(self, obj):
         from . import props
@@ -113,7 +118,7 @@ class ArmatureRuntime:
         pose_bones.foreach_get("rotation_quaternion", self.rotations.reshape(-1))
         self.rotations[self.rod_bones] = rod_rotations
         pose_bones.foreach_set("rotation_quaternion", self.rotations.reshape(-1))
-        obj.update_tag(refresh={"DATA"})
+        _tag(obj)
 
     def evaluate(self, obj, scene, frame):
         """Simulates (or recalls) `frame` and writes the rod bones' rotations."""
@@ -145,7 +150,7 @@ class ArmatureRuntime:
         self.last_frame = frame
         pose_bones = obj.pose.bones
         pose_bones.foreach_set("rotation_quaternion", self.rotations.reshape(-1))
-        obj.update_tag(refresh={"DATA"})
+        _tag(obj)
 
     def weights(self, rod_index):
         slot = self.rod_slots.get(rod_index)

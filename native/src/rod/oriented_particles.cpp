@@ -14,12 +14,16 @@ Quat extract_rotation(const Mat3& A, const Quat& guess, int max_iterations) {
     const Vec3 omega = torque / denom;
     const Real angle = omega.norm();
     if (angle < 1e-12) break;
-    q = (Quat(Eigen::AngleAxis<Real>(angle, omega / angle)) * q).normalized();
+    // Rotate by omega: the first-order quaternion [1, omega/2] (normalised) avoids sin/cos
+    // and turns by 2 atan(|omega|/2), the same direction: the iteration still converges.
+    q = (Quat(1, omega.x() / 2, omega.y() / 2, omega.z() / 2) * q).normalized();
+    // Converged: the last correction was below 1e-7 rad (warm starts need 1-3 iterations).
+    if (angle < 1e-7) break;
   }
   return q;
 }
 
-Quat match_group(const Vec3* x, const Quat* q, const Vec3* x_rest, const Quat* q_rest, const Real* w, int count,
+Quat match_group(const Vec3* x, const Vec3* x_rest, const Mat3* orientation_terms, const Real* w, int count,
                  Real ellipsoid, const Quat& guess, Vec3* goals) {
   Real mass = 0;
   Vec3 c = Vec3::Zero(), c_rest = Vec3::Zero();
@@ -35,9 +39,11 @@ Quat match_group(const Vec3* x, const Quat* q, const Vec3* x_rest, const Quat* q
     A += w[i] * (x[i] - c) * (x_rest[i] - c_rest).transpose();
     // Ellipsoid term of Müller & Chentanez 2011 (sphere of radius a: e = a²/5),
     // with the particle's rest orientation: it defines twist even on a chain.
-    A += (w[i] * ellipsoid) * (q[i].toRotationMatrix() * q_rest[i].toRotationMatrix().transpose());
+    A += (w[i] * ellipsoid) * orientation_terms[i];
   }
-  const Quat R = extract_rotation(A, guess);
+  // Few iterations suffice: the guess is the group's rotation of the previous iteration
+  // or substep, so the polar decomposition converges over time (Müller et al. 2016).
+  const Quat R = extract_rotation(A, guess, 2);
   const Mat3 Rm = R.toRotationMatrix();
   for (int i = 0; i < count; ++i) goals[i] = Rm * (x_rest[i] - c_rest) + c;
   return R;

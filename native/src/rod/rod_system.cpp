@@ -317,7 +317,7 @@ void RodSystem::simulate(std::size_t r, const FrameInput& input, const std::vect
     Real mean = 0;
     for (Real l : lengths) mean += l;
     mean /= Real(n);
-    return (0.25 * mean * mean) / 5;  // sphere of radius half a segment: a²/5
+    return (mean * mean) / 5;  // a sphere of radius one segment: a²/5
   }();
 
   const Mat3 world_to_armature = input.armature_matrix.block<3, 3>(0, 0).inverse();
@@ -325,6 +325,8 @@ void RodSystem::simulate(std::size_t r, const FrameInput& input, const std::vect
   const Real dt = 1 / rate;
   const Real decay = std::exp(-p.damping * dt);
 
+  std::vector<Mat3, Eigen::aligned_allocator<Mat3>> rest_frames(count), orientation_terms(count);
+  for (std::size_t j = 0; j < count; ++j) rest_frames[j] = q_rest[j].toRotationMatrix().transpose();
   Vec3List displacement(count);
   std::vector<int> hits(count);
   QuatList new_q(count);
@@ -362,13 +364,14 @@ void RodSystem::simulate(std::size_t r, const FrameInput& input, const std::vect
       // Shape matching over each particle's neighbourhood {c-1, c, c+1} (Jacobi: averaged).
       std::fill(displacement.begin(), displacement.end(), Vec3::Zero());
       std::fill(hits.begin(), hits.end(), 0);
+      for (std::size_t j = 0; j < count; ++j) orientation_terms[j] = s.q[j].toRotationMatrix() * rest_frames[j];
       for (std::size_t c = 1; c < count; ++c) {
         const std::size_t lo = c - 1;
         const std::size_t hi = std::min(c + 1, count - 1);
         const int members = static_cast<int>(hi - lo + 1);
         for (int i = 0; i < members; ++i) weights[i] = (lo + i) <= 1 ? kKinematicWeight : Real(1);
         const Quat guess = s.q[c] * q_rest[c].conjugate();
-        const Quat R = match_group(&s.x[lo], &s.q[lo], &x_rest[lo], &q_rest[lo], weights, members, ellipsoid, guess,
+        const Quat R = match_group(&s.x[lo], &x_rest[lo], &orientation_terms[lo], weights, members, ellipsoid, guess,
                                    goals);
         for (int i = 0; i < members; ++i) {
           const std::size_t j = lo + i;
