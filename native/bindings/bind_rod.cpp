@@ -174,7 +174,7 @@ void bind_rod(py::module_& m) {
       .def_property_readonly("bone_count", &RodSystem::bone_count)
       .def("add_rod", &add_rod, py::arg("parent_bone"), py::arg("reference_bone"), py::arg("bones"),
            py::arg("offsets"), py::arg("rest_rotations"), py::arg("stiffness") = 0.5, py::arg("damping") = 1.0,
-           py::arg("gravity") = 1.0, py::arg("substeps") = 4, py::arg("iterations") = 2, py::arg("radius") = 0.01,
+           py::arg("gravity") = 1.0, py::arg("substeps") = 4, py::arg("iterations") = 1, py::arg("radius") = 0.01,
            py::arg("wind"), py::arg("key_conditions"), py::arg("key_directions"), py::arg("key_rotations"),
            py::arg("key_speeds"), py::arg("key_influences"), py::arg("key_shapes"),
            py::arg("momentum_control") = true,

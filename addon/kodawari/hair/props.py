@@ -60,7 +60,7 @@ class KodawariHairRod(bpy.types.PropertyGroup):
                                      description="Multiple of the scene's gravity")
     substeps: bpy.props.IntProperty(name="Substeps", default=4, min=1, max=64, update=_changed,
                                     description="Substeps per 1/24 s (the rate does not depend on the frame rate)")
-    iterations: bpy.props.IntProperty(name="Iterations", default=2, min=1, max=64, update=_changed,
+    iterations: bpy.props.IntProperty(name="Iterations", default=1, min=1, max=64, update=_changed,
                                       description="Constraint iterations per substep")
     radius: bpy.props.FloatProperty(name="Radius", default=0.01, min=0.0, subtype="DISTANCE", unit="LENGTH",
                                     update=_changed, description="Thickness of the chain: margin against colliders")

@@ -43,7 +43,7 @@ Quat match_group(const Vec3* x, const Vec3* x_rest, const Mat3* orientation_term
   }
   // Few iterations suffice: the guess is the group's rotation of the previous iteration
   // or substep, so the polar decomposition converges over time (Müller et al. 2016).
-  const Quat R = extract_rotation(A, guess, 2);
+  const Quat R = extract_rotation(A, guess, 1);
   const Mat3 Rm = R.toRotationMatrix();
   for (int i = 0; i < count; ++i) goals[i] = Rm * (x_rest[i] - c_rest) + c;
   return R;

@@ -42,7 +42,7 @@ struct RodParams {
   Real damping = 1.0;       // velocity decay rate, 1/s
   Real gravity = 1.0;       // multiple of the scene's gravity
   int substeps = 4;         // substeps per 1/24 s: the substep rate is 24 * substeps Hz
-  int iterations = 2;       // constraint iterations per substep
+  int iterations = 1;       // constraint iterations per substep
   Real radius = 0.01;       // the rod's thickness: collision margin
   Vec3 wind = Vec3::Zero(); // world-space wind velocity, m/s (gusts vary it)
   bool momentum_control = true;
