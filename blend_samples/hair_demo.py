@@ -206,9 +206,9 @@ def animate(rigs, scene):
     pivot.location = (0, 0, 1.8)
     camera = bpy.data.objects.new("Camera", bpy.data.cameras.new("Camera"))
     scene.collection.objects.link(camera)
-    camera.data.lens = 95
+    camera.data.lens = 85
     camera.parent = pivot
-    camera.location = (0, -4.2, 0.25)
+    camera.location = (0, -4.2, 0.12)
     camera.rotation_euler = (math.radians(90), 0, 0)
     frames = np.array([1, 101], dtype=np.float32)
     angles = (frames - FRAMES["front"]) / 96.0 * 2 * math.pi
