@@ -242,3 +242,15 @@ def test_undo_rebuilds_from_the_restored_settings(empty_scene):
     assert fresh is not stale and fresh.weights(0).tolist() == [1.0]
     assert max(angle_deg(q, (1, 0, 0, 0)) for q in rotations(obj, name)) < 1.0
     assert max(angle_deg(q, e) for q, e in zip(rotations(obj, name), shape)) > 10.0
+
+
+def test_a_collapsed_armature_is_reported_not_raised(empty_scene):
+    obj, rod, name = _setup(empty_scene)
+    add_camera(empty_scene, "Front", (0, -4, 1.7))
+    run_frames(empty_scene, 1, 3)
+    before = rotations(obj, name)
+    obj.scale = (0.0, 0.0, 0.0)
+    bpy.context.view_layer.update()
+    empty_scene.frame_set(4)
+    assert "singular" in _runtime(obj).status
+    assert np.array_equal(rotations(obj, name), before)

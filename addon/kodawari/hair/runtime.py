@@ -163,8 +163,8 @@ def get(obj, build=True):
     """The runtime of an armature object, built (or rebuilt after a change) on demand."""
     key = obj.name_full
     rt = _runtimes.get(key)
-    if rt is not None and rt.pointer != obj.as_pointer():
-        rt = None
+    if rt is not None and (rt.pointer != obj.as_pointer() or rt.bone_count != len(obj.pose.bones)):
+        rt = None  # another object under the same name, or bones added/removed: rebuild
     if rt is None and build:
         rt = ArmatureRuntime(obj)
         _runtimes[key] = rt
@@ -191,7 +191,11 @@ def hair_armatures(scene):
 
 def evaluate_scene(scene):
     for obj in hair_armatures(scene):
-        get(obj).evaluate(obj, scene, scene.frame_current)
+        rt = get(obj)
+        try:
+            rt.evaluate(obj, scene, scene.frame_current)
+        except ValueError as exc:  # e.g. a collapsed (zero-scale) armature: say why, keep the pose
+            rt.status = f"Hair not simulated: {exc}"
 
 
 def store_state(obj):
