@@ -10,7 +10,7 @@ shopt -s nullglob
 for program in "$BUILD"/bench_*; do
   [ -x "$program" ] || continue
   echo "=== $(basename "$program")"
-  "$program" --benchmark_min_time=0.2s 2>&1 | grep -v "^\*\*\*"
+  "$program" --benchmark_min_time=0.2 2>&1 | grep -v "^\*\*\*"
 done
 for script in tests/bench/bench_*.py; do
   echo "=== $script (Blender 3.4)"
