@@ -15,4 +15,5 @@ PYBIND11_MODULE(kodawari_native, m) {
   m.attr("PYTHON_ABI") = PY_MAJOR_VERSION * 100 + PY_MINOR_VERSION;
   kodawari::bind::bind_swim(m);
   kodawari::bind::bind_ffd(m);
+  kodawari::bind::bind_rod(m);
 }

@@ -1,0 +1,32 @@
+"""Persistent application handlers: live simulation, save/reload, undo."""
+
+import bpy
+from bpy.app.handlers import persistent
+
+from . import runtime
+
+
+@persistent
+def on_frame_change(scene, depsgraph=None):
+    runtime.evaluate_scene(scene)
+
+
+@persistent
+def on_load(filepath=None):
+    runtime.clear()
+    for obj in bpy.data.objects:
+        if obj.type == "ARMATURE" and len(obj.kodawari_hair.rods):
+            runtime.restore_state(obj)
+
+
+@persistent
+def on_save(filepath=None):
+    for obj in bpy.data.objects:
+        if obj.type == "ARMATURE" and len(obj.kodawari_hair.rods):
+            runtime.store_state(obj)
+
+
+@persistent
+def on_undo(scene=None, depsgraph=None):
+    # Undo replaced the data: runtimes rebuild from the restored settings.
+    runtime.clear()

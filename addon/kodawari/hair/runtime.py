@@ -1,0 +1,224 @@
+"""Live simulation per armature: the native RodSystem, an exact per-frame cache,
+and what the panel shows (live weights, status).
+
+Frames are simulated in order; every simulated frame caches the full solver state,
+so scrubbing back is exact and playing on from any cached frame continues exactly.
+Jumping to (or before) the start frame resets. One crossing into C++ per frame:
+all pose-bone matrices in, all rod-bone rotations out, through foreach_get/set.
+"""
+
+import numpy as np
+
+from .. import native
+from . import chains
+
+# The solver state of the last evaluated frame is saved into the .blend (save_pre)
+# so that a reloaded file continues exactly where it stopped.
+STATE_PROPERTY = "kodawari_hair_state"
+STATE_FRAME_PROPERTY = "kodawari_hair_state_frame"
+NO_CAMERA = "No active camera: view keys fall back to the base shape"
+
+_runtimes = {}
+
+
+def active_camera(scene, frame):
+    """The camera of `frame`: markers bound to cameras decide (as Blender's camera switching
+    does: the last such marker at or before the frame, else the first one), else scene.camera.
+    Read here because scene.frame_set() switches the camera only after the frame handlers ran."""
+    markers = [m for m in scene.timeline_markers if m.camera is not None]
+    if not markers:
+        return scene.camera
+    before = [m for m in markers if m.frame <= frame]
+    if before:
+        return max(before, key=lambda m: m.frame).camera
+    return min(markers, key=lambda m: m.frame).camera
+
+
+def _tag(obj):
+    """foreach_set bypasses RNA updates: tag the armature so its pose is re-evaluated."""
+    obj.update_tag(refresh={"DATA"})
+
+
+class ArmatureRuntime:
+    def __init__(self, obj):
+        from . import props
+
+        kn = native.module()
+        settings = obj.kodawari_hair
+        pose_bones = obj.pose.bones
+        self.pointer = obj.as_pointer()
+        self.bone_count = len(pose_bones)
+        index = {pb.name: i for i, pb in enumerate(pose_bones)}
+        self.system = kn.RodSystem(self.bone_count, 0)
+        self.rod_slots = {}  # index in settings.rods -> index in the native system
+        self.rod_chains = {}  # index in settings.rods -> chain bone names
+        rod_bones = []
+        errors = []
+        for i, rod in enumerate(settings.rods):
+            try:
+                parent, reference, chain = chains.resolve_rod(obj, rod)
+                offsets, rest = chains.chain_geometry(parent, chain)
+                n, m = len(chain), len(rod.keys)
+                shapes = np.zeros((m, n, 4))
+                for j, key in enumerate(rod.keys):
+                    if len(key.shape) != n:
+                        raise chains.ChainError(f"Key '{key.name}' of rod '{rod.root_bone}' has {len(key.shape)} "
+                                                f"joints, the chain has {n}: re-key it")
+                    for k, joint in enumerate(key.shape):
+                        shapes[j, k] = joint.rotation
+                slot = self.system.add_rod(
+                    index[parent.name], index[reference.name], np.array([index[b.name] for b in chain], np.int32),
+                    offsets, rest, stiffness=rod.stiffness, damping=rod.damping, gravity=rod.gravity,
+                    substeps=rod.substeps, iterations=rod.iterations, radius=rod.radius,
+                    wind=np.array(rod.wind, np.float64),
+                    key_conditions=np.array([props.CONDITION_CODES[k.condition] for k in rod.keys], np.int32),
+                    key_directions=np.array([tuple(k.direction) for k in rod.keys], np.float64).reshape(m, 3),
+                    key_rotations=np.array([tuple(k.rotation) for k in rod.keys], np.float64).reshape(m, 4),
+                    key_speeds=np.array([k.speed for k in rod.keys], np.float64),
+                    key_influences=np.array([k.influence for k in rod.keys], np.float64),
+                    key_shapes=shapes.reshape(m * n, 4))
+            except ValueError as exc:  # ChainError is a ValueError, as are the solver's refusals
+                errors.append(str(exc))
+                continue
+            self.rod_slots[i] = slot
+            self.rod_chains[i] = [b.name for b in chain]
+            rod_bones.extend(index[b.name] for b in chain)
+        colliders = [c for c in settings.colliders if c.bone in index]
+        errors.extend(f"Collider bone '{c.bone}' is missing" for c in settings.colliders if c.bone not in index)
+        self.system.set_colliders(
+            np.array([index[c.bone] for c in colliders], np.int32),
+            np.array([1 if c.shape == "CAPSULE" else 0 for c in colliders], np.int32),
+            np.array([tuple(c.offset) for c in colliders], np.float64).reshape(-1, 3),
+            np.array([c.radius for c in colliders], np.float64),
+            np.array([c.length for c in colliders], np.float64))
+        self.error = "; ".join(errors)
+        self.status = ""
+        self.rod_bones = np.array(rod_bones, dtype=np.int64)
+        self.matrices = np.empty((self.bone_count, 16), np.float32)
+        self.rotations = np.empty((self.bone_count, 4), np.float32)
+        self.cache = {}  # frame -> (solver state, rod-bone rotations (k, 4))
+        self.last_frame = None
+
+    # -- one frame -------------------------------------------------------------
+    def _inputs(self, obj, scene, frame):
+        pose_bones = obj.pose.bones
+        pose_bones.foreach_get("matrix", self.matrices.reshape(-1))
+        pose_bones.foreach_get("rotation_quaternion", self.rotations.reshape(-1))
+        camera = active_camera(scene, frame)
+        self.status = "" if camera is not None else NO_CAMERA
+        camera_position = None if camera is None else np.array(camera.matrix_world.translation, np.float64)
+        gravity = np.array(scene.gravity if scene.use_gravity else (0.0, 0.0, 0.0), np.float64)
+        armature_matrix = np.array([tuple(row) for row in obj.matrix_world], np.float64)
+        return armature_matrix, camera_position, gravity
+
+    def _write(self, obj, rod_rotations):
+        if not len(self.rod_bones):
+            return
+        pose_bones = obj.pose.bones
+        pose_bones.foreach_get("rotation_quaternion", self.rotations.reshape(-1))
+        self.rotations[self.rod_bones] = rod_rotations
+        pose_bones.foreach_set("rotation_quaternion", self.rotations.reshape(-1))
+        _tag(obj)
+
+    def evaluate(self, obj, scene, frame):
+        """Simulates (or recalls) `frame` and writes the rod bones' rotations."""
+        if self.system.rod_count == 0:
+            self.status = ""
+            return
+        cached = self.cache.get(frame)
+        if cached is not None and frame > scene.frame_start:
+            if self.last_frame != frame:
+                self.system.load_state(cached[0])
+            self.last_frame = frame
+            self.status = "" if active_camera(scene, frame) is not None else NO_CAMERA
+            self._write(obj, cached[1])
+            return
+        fps = scene.render.fps / scene.render.fps_base
+        armature_matrix, camera, gravity = self._inputs(obj, scene, frame)
+        earlier = [f for f in self.cache if f < frame]
+        if frame <= scene.frame_start or not earlier:
+            self.cache.clear()
+            self.system.reset(self.matrices, armature_matrix, camera, gravity, frame / fps, self.rotations)
+        else:
+            previous = max(earlier)
+            if self.last_frame != previous:
+                self.system.load_state(self.cache[previous][0])
+            self.system.step(self.matrices, armature_matrix, camera, gravity, frame / fps,
+                             (frame - previous) / fps, self.rotations)
+        rod_rotations = self.rotations[self.rod_bones].copy()
+        self.cache[frame] = (self.system.save_state(), rod_rotations)
+        self.last_frame = frame
+        pose_bones = obj.pose.bones
+        pose_bones.foreach_set("rotation_quaternion", self.rotations.reshape(-1))
+        _tag(obj)
+
+    def weights(self, rod_index):
+        slot = self.rod_slots.get(rod_index)
+        if slot is None or self.last_frame is None:
+            return None
+        return self.system.weights(slot)
+
+
+def get(obj, build=True):
+    """The runtime of an armature object, built (or rebuilt after a change) on demand."""
+    key = obj.name_full
+    rt = _runtimes.get(key)
+    if rt is not None and (rt.pointer != obj.as_pointer() or rt.bone_count != len(obj.pose.bones)):
+        rt = None  # another object under the same name, or bones added/removed: rebuild
+    if rt is None and build:
+        rt = ArmatureRuntime(obj)
+        _runtimes[key] = rt
+    return rt
+
+
+def invalidate(obj):
+    """Settings changed: rebuild at the next frame (the simulation restarts there)."""
+    if obj is not None:
+        _runtimes.pop(obj.name_full, None)
+
+
+def clear():
+    _runtimes.clear()
+
+
+def hair_armatures(scene):
+    for obj in scene.objects:
+        if obj.type == "ARMATURE":
+            settings = getattr(obj, "kodawari_hair", None)
+            if settings is not None and settings.enabled and len(settings.rods):
+                yield obj
+
+
+def evaluate_scene(scene):
+    for obj in hair_armatures(scene):
+        rt = get(obj)
+        try:
+            rt.evaluate(obj, scene, scene.frame_current)
+        except ValueError as exc:  # e.g. a collapsed (zero-scale) armature: say why, keep the pose
+            rt.status = f"Hair not simulated: {exc}"
+
+
+def store_state(obj):
+    """Saves the last evaluated frame's solver state into the object (for reload)."""
+    rt = get(obj, build=False)
+    if rt is None or rt.last_frame is None or rt.last_frame not in rt.cache:
+        return
+    obj[STATE_PROPERTY] = rt.cache[rt.last_frame][0].tolist()
+    obj[STATE_FRAME_PROPERTY] = rt.last_frame
+
+
+def restore_state(obj):
+    """After a file opens: rebuild and seed the cache with the saved frame's state."""
+    if STATE_PROPERTY not in obj.keys():
+        return
+    rt = get(obj)
+    state = np.array(obj[STATE_PROPERTY], dtype=np.float64)
+    frame = int(obj.get(STATE_FRAME_PROPERTY, 0))
+    try:
+        rt.system.load_state(state)
+    except ValueError:
+        return  # the rods changed since the state was saved: simulate afresh
+    pose_bones = obj.pose.bones
+    pose_bones.foreach_get("rotation_quaternion", rt.rotations.reshape(-1))
+    rt.cache[frame] = (state, rt.rotations[rt.rod_bones].copy())
+    rt.last_frame = frame

@@ -1,0 +1,40 @@
+// Stateless kernels of oriented-particle shape matching (Müller & Chentanez 2011)
+// with PBD distance constraints and collision projection, as used by RodSystem.
+#pragma once
+
+#include <vector>
+
+#include "kodawari/common.hpp"
+
+namespace kodawari::rod {
+
+// The rotational part of A, found by the iterative method of Müller et al. 2016
+// ("A robust method to extract the rotational part of deformations"), warm-started
+// from `guess`. Deterministic: a fixed iteration cap and a fixed tolerance.
+Quat extract_rotation(const Mat3& A, const Quat& guess, int max_iterations = 24);
+
+// One shape-matching group: members' current positions x, rest positions x_rest,
+// orientation terms E_i = R(q_i) R(q̄_i)^T (current times rest orientation, transposed;
+// computed once per particle and shared by its groups), weights w (mass). Computes
+//   A = sum w_i (x_i - c)(x̄_i - c̄)^T + sum w_i e E_i    (ellipsoid term, e = a²/5)
+// R = polar(A) and the goals g_i = R (x̄_i - c̄) + c. Returns R.
+Quat match_group(const Vec3* x, const Vec3* x_rest, const Mat3* orientation_terms, const Real* w, int count,
+                 Real ellipsoid, const Quat& guess, Vec3* goals);
+
+// PBD distance constraint between a and b with inverse masses wa, wb.
+void project_distance(Vec3& a, Vec3& b, Real wa, Real wb, Real rest_length);
+
+struct Collider {
+  Vec3 start;         // sphere centre, or capsule axis start
+  Vec3 end;           // capsule axis end (== start for a sphere)
+  Real radius = 0.0;  // collider radius (the rod's radius is added as margin)
+};
+
+// Pushes p out of every collider inflated by `margin`; true when it moved.
+bool push_out_of_colliders(Vec3& p, const std::vector<Collider>& colliders, Real margin);
+
+// Minimal rotation taking unit vector a to unit vector b, applied before q:
+// keeps q's twist about a while aligning a with b.
+Quat align_axis(const Quat& q, const Vec3& axis_local, const Vec3& target_direction);
+
+}  // namespace kodawari::rod

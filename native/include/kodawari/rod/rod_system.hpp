@@ -1,0 +1,142 @@
+// Many rods, one per unbranched joint chain, simulated together: the stateful
+// side of the rod solver. One call per frame takes every bone matrix of the
+// armature and writes every rod bone's rotation, so Blender crosses into C++ once.
+//
+// Per rod and substep (oriented particles, Müller & Chentanez 2011):
+//   predict x and q from v, ω, gravity, wind (GLM-noise gusts), damping;
+//   `iterations` x { shape matching over each particle's neighbourhood {j-1, j, j+1},
+//                   PBD distance constraints, collider push-out };
+//   exact-length pass from the root, v = Δx/dt, ω from q·q_old⁻¹.
+// Particles: 0 = a kinematic "ghost" behind the root fixed in the parent's frame (it
+// gives the root bone its rest direction relative to the head), 1 = the root joint
+// (kinematic position, dynamic orientation), 2..n = the following joints, n+1 = the tip.
+// The rest shape is re-blended from the keys every frame (view, pose, speed weights);
+// with momentum control (Koyama & Igarashi 2013) a change of rest shape carries the
+// chain's current deviation from rest over to the new rest shape kinematically, so a
+// jump (camera cut) adds no velocity: the chain is not flung.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "kodawari/common.hpp"
+#include "kodawari/rod/oriented_particles.hpp"
+#include "kodawari/rod/shape_blend.hpp"
+
+namespace kodawari::rod {
+
+enum class Condition : int { View = 0, Pose = 1, Speed = 2 };
+
+struct RodKey {
+  Condition condition = Condition::View;
+  Vec3 direction = Vec3::UnitY();        // VIEW: unit, in the reference bone's frame
+  Quat rotation = Quat::Identity();      // POSE: the reference bone's armature-space rotation
+  Real speed = 0.0;                      // SPEED: the reference bone's speed, m/s
+  Real influence = 1.0;                  // p_i > 0
+  QuatList shape;                        // per-bone rotations (pose-bone rotation_quaternion)
+};
+
+struct RodParams {
+  Real stiffness = 0.5;     // shape-matching fraction per iteration, (0, 1]
+  Real damping = 1.0;       // velocity decay rate, 1/s
+  Real gravity = 1.0;       // multiple of the scene's gravity
+  int substeps = 4;         // substeps per 1/24 s: the substep rate is 24 * substeps Hz
+  int iterations = 1;       // constraint iterations per substep
+  Real radius = 0.01;       // the rod's thickness: collision margin
+  Vec3 wind = Vec3::Zero(); // world-space wind velocity, m/s (gusts vary it)
+  bool momentum_control = true;
+};
+
+struct RodDefinition {
+  int parent_bone = -1;     // index of the kinematic parent in the armature's pose bones
+  int reference_bone = -1;  // bone whose frame defines view directions
+  std::vector<int> bones;   // the chain, root first
+  ChainGeometry geometry;
+  RodParams params;
+  std::vector<RodKey> keys;
+};
+
+struct ColliderDefinition {
+  int bone = -1;       // collider follows this pose bone
+  bool capsule = false;
+  Vec3 offset = Vec3::Zero();  // centre / axis start in the bone's frame
+  Real radius = 0.1;
+  Real length = 0.0;   // capsule: axis length along the bone's Y
+};
+
+// Inputs of one frame, all for the whole armature.
+struct FrameInput {
+  const float* bone_matrices = nullptr;  // B x 16, column-major 4x4 (pose_bones.foreach_get("matrix"))
+  std::size_t bone_count = 0;
+  Eigen::Matrix<Real, 4, 4> armature_matrix = Eigen::Matrix<Real, 4, 4>::Identity();  // object to world
+  bool has_camera = false;
+  Vec3 camera = Vec3::Zero();   // world space
+  Vec3 gravity = Vec3(0, 0, -9.81);  // world space
+  Real time = 0.0;              // seconds (frame / fps): drives wind gusts
+  Real frame_dt = 1.0 / 24.0;   // seconds since the previous frame
+};
+
+struct RodState {
+  Vec3List x, v, prev_x;     // particles (n + 2)
+  QuatList q, prev_q;
+  Vec3List omega;
+  QuatList rest_local;       // rest shape used last frame (for momentum control)
+  QuatList last_output;      // last basis written per bone (keeps quaternion signs continuous)
+  Vec3 anchor_position = Vec3::Zero();
+  Quat anchor_rotation = Quat::Identity();
+  Vec3 reference_position = Vec3::Zero();  // world, for the speed condition
+  Real time_accumulator = 0.0;
+  Real speed = 0.0;
+  bool initialised = false;
+};
+
+class RodSystem {
+ public:
+  explicit RodSystem(std::size_t bone_count, unsigned threads = 0);
+
+  // Validates and adds a rod; returns its index. Throws std::invalid_argument.
+  std::size_t add_rod(RodDefinition rod);
+  void set_colliders(std::vector<ColliderDefinition> colliders);
+
+  // Puts every rod into its rest shape for the current condition, at rest.
+  void reset(const FrameInput& input, float* rotations_out);
+  // Advances one frame (frame_dt seconds) and writes each rod bone's rotation
+  // (w, x, y, z) into rotations_out (B x 4); other rows are left untouched.
+  void step(const FrameInput& input, float* rotations_out);
+
+  std::size_t rod_count() const { return rods_.size(); }
+  std::size_t bone_count() const { return bone_count_; }
+  const RodDefinition& rod(std::size_t i) const { return rods_[i]; }
+  // Joint positions (heads and tip, n + 1) in armature space.
+  Vec3List joint_positions(std::size_t rod) const;
+  Vec3List joint_velocities(std::size_t rod) const;
+  const std::vector<Real>& weights(std::size_t rod) const { return weights_[rod]; }
+  Real reference_speed(std::size_t rod) const { return states_[rod].speed; }
+  // The rest shape blended this frame (per-bone rotations).
+  const QuatList& rest_shape(std::size_t rod) const { return states_[rod].rest_local; }
+
+  // The whole simulation state as doubles, for exact per-frame caching.
+  std::vector<Real> save_state() const;
+  void load_state(const std::vector<Real>& state);
+  std::size_t state_size() const;
+
+ private:
+  void begin_frame(std::size_t r, const FrameInput& input, const std::vector<Collider>& colliders, bool reset);
+  void simulate(std::size_t r, const FrameInput& input, const std::vector<Collider>& colliders);
+  void write_output(std::size_t r, float* rotations_out);
+  std::vector<Collider> world_colliders(const FrameInput& input) const;
+
+  std::size_t bone_count_;
+  unsigned threads_;
+  std::vector<RodDefinition> rods_;
+  std::vector<RodState> states_;
+  std::vector<std::vector<Real>> weights_;
+  std::vector<ColliderDefinition> colliders_;
+};
+
+// Matrix of pose bone `index` from the foreach_get buffer, with rotation and position.
+void bone_transform(const float* bone_matrices, std::size_t index, Quat& rotation, Vec3& position,
+                    Eigen::Matrix<Real, 3, 3>* linear = nullptr);
+
+}  // namespace kodawari::rod

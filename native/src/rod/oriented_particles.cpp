@@ -1,0 +1,87 @@
+#include "kodawari/rod/oriented_particles.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace kodawari::rod {
+
+Quat extract_rotation(const Mat3& A, const Quat& guess, int max_iterations) {
+  Quat q = guess.normalized();
+  for (int it = 0; it < max_iterations; ++it) {
+    const Mat3 R = q.toRotationMatrix();
+    const Vec3 torque = R.col(0).cross(A.col(0)) + R.col(1).cross(A.col(1)) + R.col(2).cross(A.col(2));
+    const Real denom = std::abs(R.col(0).dot(A.col(0)) + R.col(1).dot(A.col(1)) + R.col(2).dot(A.col(2))) + 1e-12;
+    const Vec3 omega = torque / denom;
+    const Real angle = omega.norm();
+    if (angle < 1e-12) break;
+    // Rotate by omega: the first-order quaternion [1, omega/2] (normalised) avoids sin/cos
+    // and turns by 2 atan(|omega|/2), the same direction: the iteration still converges.
+    q = (Quat(1, omega.x() / 2, omega.y() / 2, omega.z() / 2) * q).normalized();
+    // Converged: the last correction was below 1e-7 rad (warm starts need 1-3 iterations).
+    if (angle < 1e-7) break;
+  }
+  return q;
+}
+
+Quat match_group(const Vec3* x, const Vec3* x_rest, const Mat3* orientation_terms, const Real* w, int count,
+                 Real ellipsoid, const Quat& guess, Vec3* goals) {
+  Real mass = 0;
+  Vec3 c = Vec3::Zero(), c_rest = Vec3::Zero();
+  for (int i = 0; i < count; ++i) {
+    mass += w[i];
+    c += w[i] * x[i];
+    c_rest += w[i] * x_rest[i];
+  }
+  c /= mass;
+  c_rest /= mass;
+  Mat3 A = Mat3::Zero();
+  for (int i = 0; i < count; ++i) {
+    A += w[i] * (x[i] - c) * (x_rest[i] - c_rest).transpose();
+    // Ellipsoid term of Müller & Chentanez 2011 (sphere of radius a: e = a²/5),
+    // with the particle's rest orientation: it defines twist even on a chain.
+    A += (w[i] * ellipsoid) * orientation_terms[i];
+  }
+  // Few iterations suffice: the guess is the group's rotation of the previous iteration
+  // or substep, so the polar decomposition converges over time (Müller et al. 2016).
+  const Quat R = extract_rotation(A, guess, 1);
+  const Mat3 Rm = R.toRotationMatrix();
+  for (int i = 0; i < count; ++i) goals[i] = Rm * (x_rest[i] - c_rest) + c;
+  return R;
+}
+
+void project_distance(Vec3& a, Vec3& b, Real wa, Real wb, Real rest_length) {
+  const Real wsum = wa + wb;
+  if (wsum <= 0) return;
+  const Vec3 d = b - a;
+  const Real len = d.norm();
+  if (len < 1e-12) return;
+  const Vec3 correction = (len - rest_length) / (len * wsum) * d;
+  a += wa * correction;
+  b -= wb * correction;
+}
+
+bool push_out_of_colliders(Vec3& p, const std::vector<Collider>& colliders, Real margin) {
+  bool moved = false;
+  for (const Collider& c : colliders) {
+    const Vec3 axis = c.end - c.start;
+    const Real len2 = axis.squaredNorm();
+    const Real t = len2 > 0 ? std::clamp((p - c.start).dot(axis) / len2, Real(0), Real(1)) : Real(0);
+    const Vec3 closest = c.start + t * axis;
+    const Vec3 d = p - closest;
+    const Real dist = d.norm();
+    const Real r = c.radius + margin;
+    if (dist >= r) continue;
+    // A point exactly on the axis has no outward direction: push along +Z, deterministically.
+    const Vec3 n = dist > 1e-12 ? Vec3(d / dist) : Vec3::UnitZ();
+    p = closest + r * n;
+    moved = true;
+  }
+  return moved;
+}
+
+Quat align_axis(const Quat& q, const Vec3& axis_local, const Vec3& target_direction) {
+  const Vec3 current = q * axis_local;
+  return (Quat::FromTwoVectors(current, target_direction) * q).normalized();
+}
+
+}  // namespace kodawari::rod

@@ -1,0 +1,570 @@
+#include "kodawari/rod/rod_system.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include <glm/gtc/noise.hpp>
+#include <glm/vec2.hpp>
+
+#include "kodawari/parallel.hpp"
+#include "kodawari/rod/view_weights.hpp"
+
+namespace kodawari::rod {
+
+namespace {
+
+// Ghost and root are kinematic; their larger weight in each group fit makes the
+// root bone hold its rest direction relative to the parent more firmly.
+constexpr Real kKinematicWeight = 4.0;
+// Wind acts as drag towards the wind velocity: a = kWindDrag * (wind - v).
+constexpr Real kWindDrag = 1.5;
+// Gust frequency (Hz) and strength of the GLM Perlin noise that modulates the wind.
+constexpr Real kGustFrequency = 0.7;
+constexpr Real kGustAmount = 0.6;
+// Substep rate unit: `substeps` counts substeps per 1/24 s, whatever the scene's fps.
+constexpr Real kSubstepUnit = 24.0;
+constexpr long kMaxSubstepsPerFrame = 4096;
+
+bool finite(const Vec3& v) { return v.allFinite(); }
+bool finite(const Quat& q) { return q.coeffs().allFinite(); }
+
+// Spin integration to first order, q <- normalise([1, ω dt / 2] q), and its exact inverse
+// ω = 2 vec(dq) / (w(dq) dt): consistent with each other and free of sin/cos/atan2, which
+// matters at tens of thousands of particles per substep (dt ω is small at these rates).
+Quat exp_rotation(const Vec3& rotation_vector) {
+  return Quat(1, rotation_vector.x() / 2, rotation_vector.y() / 2, rotation_vector.z() / 2).normalized();
+}
+
+// Angular velocity that turns `from` into `to` in dt (inverse of exp_rotation).
+Vec3 angular_velocity(const Quat& from, const Quat& to, Real dt) {
+  Quat dq = to * from.conjugate();
+  if (dq.w() < 0) dq.coeffs() = -dq.coeffs();
+  if (dq.w() < 1e-6) return Vec3::Zero();  // a half turn in one substep: no meaningful spin
+  return dq.vec() * (2 / (dq.w() * dt));
+}
+
+}  // namespace
+
+void bone_transform(const float* bone_matrices, std::size_t index, Quat& rotation, Vec3& position,
+                    Eigen::Matrix<Real, 3, 3>* linear) {
+  const Eigen::Map<const Eigen::Matrix<float, 4, 4>> m(bone_matrices + 16 * index);
+  Mat3 l = m.block<3, 3>(0, 0).cast<Real>();
+  position = m.block<3, 1>(0, 3).cast<Real>();
+  if (linear) *linear = l;
+  // Remove scale: normalise the columns (pose bones are rotation + uniform scale here).
+  for (int c = 0; c < 3; ++c) {
+    const Real n = l.col(c).norm();
+    if (n > 1e-12) l.col(c) /= n;
+  }
+  rotation = Quat(l).normalized();
+}
+
+RodSystem::RodSystem(std::size_t bone_count, unsigned threads) : bone_count_(bone_count), threads_(threads) {}
+
+std::size_t RodSystem::add_rod(RodDefinition rod) {
+  const std::size_t n = rod.bones.size();
+  auto fail = [](const std::string& why) { throw std::invalid_argument(why); };
+  if (n == 0) fail("a rod needs at least one joint (got 0 bones)");
+  if (rod.geometry.offsets.size() != n + 1) fail("offsets must have one row per bone plus the tip");
+  if (rod.geometry.rest_rotations.size() != n) fail("rest_rotations must have one row per bone");
+  auto valid_bone = [&](int b) { return b >= 0 && static_cast<std::size_t>(b) < bone_count_; };
+  if (!valid_bone(rod.parent_bone)) fail("parent_bone is not a bone index of this armature");
+  if (!valid_bone(rod.reference_bone)) fail("reference_bone is not a bone index of this armature");
+  for (int b : rod.bones) {
+    if (!valid_bone(b)) fail("bones contains an index outside the armature");
+    if (b == rod.parent_bone) fail("the parent bone cannot be part of its own rod");
+  }
+  for (const Vec3& o : rod.geometry.offsets) {
+    if (!finite(o)) fail("offsets contain NaN or inf");
+  }
+  for (std::size_t k = 0; k < n; ++k) {
+    if (!(rod.geometry.segment_length(k) > 1e-6)) fail("bone " + std::to_string(k) + " of the rod has zero length");
+    Quat& q = rod.geometry.rest_rotations[k];
+    if (!finite(q) || q.norm() < 1e-6) fail("rest_rotations contain NaN or a zero quaternion");
+    q.normalize();
+  }
+  RodParams& p = rod.params;
+  if (!(p.stiffness > 0 && p.stiffness <= 1)) fail("stiffness must be in (0, 1]");
+  if (!(p.damping >= 0) || !std::isfinite(p.damping)) fail("damping must be >= 0");
+  if (!std::isfinite(p.gravity)) fail("gravity must be finite");
+  if (p.substeps < 1 || p.substeps > 64) fail("substeps must be in 1..64");
+  if (p.iterations < 1 || p.iterations > 64) fail("iterations must be in 1..64");
+  if (!(p.radius >= 0) || !std::isfinite(p.radius)) fail("radius must be >= 0");
+  if (!finite(p.wind)) fail("wind must be finite");
+  for (RodKey& key : rod.keys) {
+    if (!(key.influence > 0) || !std::isfinite(key.influence)) fail("key influences must be > 0");
+    if (key.shape.size() != n) fail("every key shape needs one rotation per bone");
+    for (Quat& q : key.shape) {
+      if (!finite(q) || q.norm() < 1e-6) fail("a key shape contains NaN or a zero quaternion");
+      q.normalize();
+    }
+    if (key.condition == Condition::View) {
+      if (!finite(key.direction) || key.direction.norm() < 1e-9) fail("a view key has a zero or NaN direction");
+      key.direction.normalize();
+    } else if (key.condition == Condition::Pose) {
+      if (!finite(key.rotation) || key.rotation.norm() < 1e-6) fail("a pose key has a NaN or zero rotation");
+      key.rotation.normalize();
+    } else if (!(key.speed >= 0) || !std::isfinite(key.speed)) {
+      fail("a speed key needs a speed >= 0");
+    }
+  }
+  rods_.push_back(std::move(rod));
+  states_.emplace_back();
+  weights_.emplace_back(rods_.back().keys.size() + 1, Real(0));
+  weights_.back()[0] = 1;
+  return rods_.size() - 1;
+}
+
+void RodSystem::set_colliders(std::vector<ColliderDefinition> colliders) {
+  for (const auto& c : colliders) {
+    if (c.bone < 0 || static_cast<std::size_t>(c.bone) >= bone_count_) {
+      throw std::invalid_argument("a collider bone index is outside the armature");
+    }
+    if (!(c.radius >= 0) || !std::isfinite(c.radius) || !(c.length >= 0) || !finite(c.offset)) {
+      throw std::invalid_argument("collider radius and length must be finite and >= 0");
+    }
+  }
+  colliders_ = std::move(colliders);
+}
+
+std::vector<Collider> RodSystem::world_colliders(const FrameInput& input) const {
+  std::vector<Collider> out;
+  out.reserve(colliders_.size());
+  for (const auto& c : colliders_) {
+    Quat r;
+    Vec3 t;
+    bone_transform(input.bone_matrices, static_cast<std::size_t>(c.bone), r, t);
+    Collider w;
+    w.start = t + r * c.offset;
+    w.end = c.capsule ? Vec3(w.start + r * Vec3(0, c.length, 0)) : w.start;
+    w.radius = c.radius;
+    out.push_back(w);
+  }
+  return out;
+}
+
+namespace {
+
+// Rest particles in the anchor frame (see the header for the particle layout).
+void rest_particles(const ChainGeometry& g, const QuatList& rest, Vec3List& x_rest, QuatList& q_rest) {
+  const std::size_t n = g.bone_count();
+  QuatList frames;
+  Vec3List heads;
+  chain_forward_kinematics(g, rest, frames, heads);
+  x_rest.resize(n + 2);
+  q_rest.resize(n + 2);
+  x_rest[0] = -g.segment_length(0) * g.segment_axis(0);
+  q_rest[0] = Quat::Identity();
+  for (std::size_t j = 1; j <= n + 1; ++j) {
+    x_rest[j] = heads[j - 1];
+    q_rest[j] = frames[std::min(j - 1, n - 1)];
+  }
+}
+
+// Bone frames of the current state: each particle's orientation turned so the bone
+// axis lies along its actual segment.
+void bone_frames(const ChainGeometry& g, const RodState& s, QuatList& frames) {
+  const std::size_t n = g.bone_count();
+  frames.resize(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    const Vec3 seg = s.x[k + 2] - s.x[k + 1];
+    frames[k] = align_axis(s.q[k + 1], g.segment_axis(k), seg.normalized());
+  }
+}
+
+}  // namespace
+
+void RodSystem::begin_frame(std::size_t r, const FrameInput& input, const std::vector<Collider>& colliders,
+                            bool reset) {
+  (void)colliders;
+  const RodDefinition& rod = rods_[r];
+  RodState& s = states_[r];
+  const std::size_t n = rod.bones.size();
+  const Mat3 arm_linear = input.armature_matrix.block<3, 3>(0, 0);
+  const Vec3 arm_translation = input.armature_matrix.block<3, 1>(0, 3);
+
+  // Reference joint: view direction in its frame, its rotation, its speed.
+  Quat ref_rotation;
+  Vec3 ref_position;
+  bone_transform(input.bone_matrices, static_cast<std::size_t>(rod.reference_bone), ref_rotation, ref_position);
+  const Vec3 ref_world = arm_linear * ref_position + arm_translation;
+  s.speed = (s.initialised && !reset && input.frame_dt > 0) ? (ref_world - s.reference_position).norm() / input.frame_dt
+                                                            : Real(0);
+  s.reference_position = ref_world;
+  bool has_view = false;
+  Vec3 view = Vec3::Zero();
+  if (input.has_camera) {
+    const Vec3 camera_armature = arm_linear.inverse() * (input.camera - arm_translation);
+    view = ref_rotation.conjugate() * (camera_armature - ref_position);
+    has_view = view.norm() > 1e-9;
+    if (has_view) view.normalize();
+  }
+  std::vector<Real> similarities(rod.keys.size()), influences(rod.keys.size());
+  for (std::size_t i = 0; i < rod.keys.size(); ++i) {
+    const RodKey& key = rod.keys[i];
+    influences[i] = key.influence;
+    switch (key.condition) {
+      case Condition::View:
+        // No camera (or a camera inside the joint): view keys drop out, the base shape takes over.
+        similarities[i] = has_view ? view_similarity(key.direction, view) : Real(0);
+        break;
+      case Condition::Pose:
+        similarities[i] = pose_similarity(key.rotation, ref_rotation);
+        break;
+      case Condition::Speed:
+        similarities[i] = speed_similarity(key.speed, s.speed);
+        break;
+    }
+  }
+  weights_[r] = condition_weights(similarities, influences);
+  std::vector<QuatList> shapes;
+  shapes.reserve(rod.keys.size());
+  for (const RodKey& key : rod.keys) shapes.push_back(key.shape);
+  QuatList rest = blend_shapes(shapes, weights_[r], n);
+
+  if (reset || !s.initialised) {
+    Quat parent_rotation;
+    Vec3 parent_position;
+    Mat3 parent_linear;
+    bone_transform(input.bone_matrices, static_cast<std::size_t>(rod.parent_bone), parent_rotation, parent_position,
+                   &parent_linear);
+    s.anchor_position = parent_linear * rod.geometry.offsets[0] + parent_position;
+    s.anchor_rotation = (parent_rotation * rod.geometry.rest_rotations[0]).normalized();
+    Vec3List x_rest;
+    QuatList q_rest;
+    rest_particles(rod.geometry, rest, x_rest, q_rest);
+    s.x.resize(n + 2);
+    s.q.resize(n + 2);
+    s.v.assign(n + 2, Vec3::Zero());
+    s.omega.assign(n + 2, Vec3::Zero());
+    s.prev_x.resize(n + 2);
+    s.prev_q.resize(n + 2);
+    for (std::size_t j = 0; j < n + 2; ++j) {
+      s.x[j] = s.anchor_position + s.anchor_rotation * x_rest[j];
+      s.q[j] = (s.anchor_rotation * q_rest[j]).normalized();
+    }
+    s.last_output.assign(n, Quat::Identity());
+    s.time_accumulator = 0;
+    s.rest_local = rest;
+    s.initialised = true;
+    return;
+  }
+
+  bool changed = false;
+  for (std::size_t k = 0; k < n && !changed; ++k) changed = !(rest[k].coeffs() == s.rest_local[k].coeffs());
+  if (changed && rod.params.momentum_control) {
+    // Momentum control (the contribution of Koyama & Igarashi 2013, our formulation):
+    // keep each joint's deviation from rest, E_k = rest_old_k⁻¹ · local_k, and re-apply it
+    // on the new rest shape by forward kinematics from the root. Positions move
+    // kinematically and velocities are untouched, so a rest shape that jumps adds no
+    // momentum and nothing is flung.
+    const Vec3List& offsets = rod.geometry.offsets;
+    const QuatList& rest_rotations = rod.geometry.rest_rotations;
+    QuatList frames, new_frames(n);
+    bone_frames(rod.geometry, s, frames);
+    const Quat tip_offset = frames[n - 1].conjugate() * s.q[n + 1];
+    Vec3 head = s.x[1];
+    for (std::size_t k = 0; k < n; ++k) {
+      const Quat old_parent = k == 0 ? s.anchor_rotation : Quat(frames[k - 1] * rest_rotations[k]);
+      const Quat new_parent = k == 0 ? s.anchor_rotation : Quat(new_frames[k - 1] * rest_rotations[k]);
+      const Quat deviation = s.rest_local[k].conjugate() * (old_parent.conjugate() * frames[k]);
+      new_frames[k] = (new_parent * rest[k] * deviation).normalized();
+      if (k > 0) head += new_frames[k - 1] * offsets[k];
+      s.x[k + 1] = head;
+      s.q[k + 1] = new_frames[k];
+    }
+    s.x[n + 1] = head + new_frames[n - 1] * offsets[n];
+    s.q[n + 1] = (new_frames[n - 1] * tip_offset).normalized();
+  }
+  s.rest_local = rest;
+}
+
+void RodSystem::simulate(std::size_t r, const FrameInput& input, const std::vector<Collider>& colliders) {
+  const RodDefinition& rod = rods_[r];
+  const RodParams& p = rod.params;
+  RodState& s = states_[r];
+  const std::size_t n = rod.bones.size();
+  const std::size_t count = n + 2;
+
+  // Kinematic anchor at the end of this frame.
+  Quat parent_rotation;
+  Vec3 parent_position;
+  Mat3 parent_linear;
+  bone_transform(input.bone_matrices, static_cast<std::size_t>(rod.parent_bone), parent_rotation, parent_position,
+                 &parent_linear);
+  const Vec3 anchor_end = parent_linear * rod.geometry.offsets[0] + parent_position;
+  Quat anchor_end_rotation = (parent_rotation * rod.geometry.rest_rotations[0]).normalized();
+  if (anchor_end_rotation.dot(s.anchor_rotation) < 0) anchor_end_rotation.coeffs() = -anchor_end_rotation.coeffs();
+  const Vec3 anchor_start = s.anchor_position;
+  const Quat anchor_start_rotation = s.anchor_rotation;
+
+  // Fixed substep rate, independent of the scene's frame rate; leftover time carries over.
+  const Real rate = kSubstepUnit * p.substeps;
+  s.time_accumulator += std::max(input.frame_dt, Real(0));
+  long steps = static_cast<long>(std::floor(s.time_accumulator * rate + 1e-9));
+  s.time_accumulator = std::max(Real(0), s.time_accumulator - Real(steps) / rate);
+  steps = std::min(steps, kMaxSubstepsPerFrame);
+
+  Vec3List x_rest;
+  QuatList q_rest;
+  rest_particles(rod.geometry, s.rest_local, x_rest, q_rest);
+  std::vector<Real> lengths(n);
+  for (std::size_t k = 0; k < n; ++k) lengths[k] = rod.geometry.segment_length(k);
+  const Real ellipsoid = [&] {
+    Real mean = 0;
+    for (Real l : lengths) mean += l;
+    mean /= Real(n);
+    return (mean * mean) / 5;  // a sphere of radius one segment: a²/5
+  }();
+
+  const Mat3 world_to_armature = input.armature_matrix.block<3, 3>(0, 0).inverse();
+  const Vec3 gravity = world_to_armature * (input.gravity * p.gravity);
+  const Real dt = 1 / rate;
+  const Real decay = std::exp(-p.damping * dt);
+
+  std::vector<Mat3, Eigen::aligned_allocator<Mat3>> rest_frames(count), orientation_terms(count);
+  for (std::size_t j = 0; j < count; ++j) rest_frames[j] = q_rest[j].toRotationMatrix().transpose();
+  Vec3List displacement(count);
+  std::vector<int> hits(count);
+  QuatList new_q(count);
+  Vec3 goals[3];
+  Real weights[3];
+  for (long step = 1; step <= steps; ++step) {
+    const Real f = Real(step) / Real(steps);
+    const Vec3 anchor = anchor_start + f * (anchor_end - anchor_start);
+    const Quat anchor_rotation = anchor_start_rotation.slerp(f, anchor_end_rotation).normalized();
+    s.x[0] = anchor + anchor_rotation * x_rest[0];
+    s.q[0] = anchor_rotation;
+    s.x[1] = anchor;
+
+    // Wind with gusts: GLM Perlin noise over time, one noise line per rod (deterministic).
+    const Real t = input.time - (1 - f) * input.frame_dt;
+    const Real gust = 1 + kGustAmount * Real(glm::perlin(glm::dvec2(t * kGustFrequency, 0.37 * Real(r) + 0.5)));
+    const Vec3 wind = world_to_armature * (p.wind * gust);
+    const bool windy = p.wind.squaredNorm() > 0;
+
+    // Predict.
+    for (std::size_t j = 2; j < count; ++j) {
+      Vec3 a = gravity;
+      if (windy) a += kWindDrag * (wind - s.v[j]);
+      s.v[j] = decay * s.v[j] + dt * a;
+      s.prev_x[j] = s.x[j];
+      s.x[j] += dt * s.v[j];
+    }
+    for (std::size_t j = 1; j < count; ++j) {
+      s.omega[j] *= decay;
+      s.prev_q[j] = s.q[j];
+      s.q[j] = (exp_rotation(s.omega[j] * dt) * s.q[j]).normalized();
+    }
+
+    for (int it = 0; it < p.iterations; ++it) {
+      // Shape matching over each particle's neighbourhood {c-1, c, c+1} (Jacobi: averaged).
+      std::fill(displacement.begin(), displacement.end(), Vec3::Zero());
+      std::fill(hits.begin(), hits.end(), 0);
+      for (std::size_t j = 0; j < count; ++j) orientation_terms[j] = s.q[j].toRotationMatrix() * rest_frames[j];
+      for (std::size_t c = 1; c < count; ++c) {
+        const std::size_t lo = c - 1;
+        const std::size_t hi = std::min(c + 1, count - 1);
+        const int members = static_cast<int>(hi - lo + 1);
+        for (int i = 0; i < members; ++i) weights[i] = (lo + i) <= 1 ? kKinematicWeight : Real(1);
+        const Quat guess = s.q[c] * q_rest[c].conjugate();
+        const Quat R = match_group(&s.x[lo], &x_rest[lo], &orientation_terms[lo], weights, members, ellipsoid, guess,
+                                   goals);
+        for (int i = 0; i < members; ++i) {
+          const std::size_t j = lo + i;
+          if (j < 2) continue;
+          displacement[j] += goals[i] - s.x[j];
+          ++hits[j];
+        }
+        new_q[c] = (R * q_rest[c]).normalized();
+      }
+      for (std::size_t j = 2; j < count; ++j) s.x[j] += p.stiffness * displacement[j] / Real(hits[j]);
+      for (std::size_t c = 1; c < count; ++c) {
+        Quat target = new_q[c];
+        if (target.dot(s.q[c]) < 0) target.coeffs() = -target.coeffs();
+        s.q[c].coeffs() = (1 - p.stiffness) * s.q[c].coeffs() + p.stiffness * target.coeffs();
+        s.q[c].normalize();
+      }
+      // Inextensibility: PBD distance constraints, root (kinematic) to tip.
+      for (std::size_t k = 0; k < n; ++k) project_distance(s.x[k + 1], s.x[k + 2], k == 0 ? 0 : 1, 1, lengths[k]);
+      if (!colliders.empty()) {
+        for (std::size_t j = 2; j < count; ++j) push_out_of_colliders(s.x[j], colliders, p.radius);
+      }
+    }
+    // Exact lengths from the root; a joint pushed out of a collider is re-pulled onto
+    // its bone length, a few times, so both hold on output.
+    for (std::size_t k = 0; k < n; ++k) {
+      Vec3& a = s.x[k + 1];
+      Vec3& b = s.x[k + 2];
+      for (int pass = 0; pass < 4; ++pass) {
+        const Vec3 d = b - a;
+        const Real len = d.norm();
+        b = len > 1e-12 ? Vec3(a + d * (lengths[k] / len)) : Vec3(a + s.q[k + 1] * (lengths[k] * rod.geometry.segment_axis(k)));
+        if (colliders.empty() || !push_out_of_colliders(b, colliders, p.radius)) break;
+      }
+    }
+    for (std::size_t j = 2; j < count; ++j) s.v[j] = (s.x[j] - s.prev_x[j]) / dt;
+    for (std::size_t j = 1; j < count; ++j) s.omega[j] = angular_velocity(s.prev_q[j], s.q[j], dt);
+  }
+  s.anchor_position = anchor_end;
+  s.anchor_rotation = anchor_end_rotation;
+  if (steps == 0) {
+    // No substep this frame: the chain still follows its root rigidly.
+    const Quat delta = anchor_end_rotation * anchor_start_rotation.conjugate();
+    for (std::size_t j = 0; j < count; ++j) {
+      s.x[j] = anchor_end + delta * (s.x[j] - anchor_start);
+      s.q[j] = (delta * s.q[j]).normalized();
+    }
+  }
+}
+
+void RodSystem::write_output(std::size_t r, float* rotations_out) {
+  const RodDefinition& rod = rods_[r];
+  RodState& s = states_[r];
+  const std::size_t n = rod.bones.size();
+  QuatList frames;
+  bone_frames(rod.geometry, s, frames);
+  for (std::size_t k = 0; k < n; ++k) {
+    const Quat parent = k == 0 ? s.anchor_rotation : Quat(frames[k - 1] * rod.geometry.rest_rotations[k]);
+    Quat basis = (parent.conjugate() * frames[k]).normalized();
+    // Keep the sign continuous from frame to frame so baked F-curves interpolate.
+    if (basis.dot(s.last_output[k]) < 0) basis.coeffs() = -basis.coeffs();
+    s.last_output[k] = basis;
+    float* out = rotations_out + 4 * static_cast<std::size_t>(rod.bones[k]);
+    out[0] = static_cast<float>(basis.w());
+    out[1] = static_cast<float>(basis.x());
+    out[2] = static_cast<float>(basis.y());
+    out[3] = static_cast<float>(basis.z());
+  }
+}
+
+void RodSystem::reset(const FrameInput& input, float* rotations_out) {
+  const std::vector<Collider> colliders = world_colliders(input);
+  parallel_for(rods_.size(), threads_, 16, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t r = begin; r < end; ++r) {
+      begin_frame(r, input, colliders, true);
+      if (rotations_out) write_output(r, rotations_out);
+    }
+  });
+}
+
+void RodSystem::step(const FrameInput& input, float* rotations_out) {
+  const std::vector<Collider> colliders = world_colliders(input);
+  parallel_for(rods_.size(), threads_, 16, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t r = begin; r < end; ++r) {
+      const bool fresh = !states_[r].initialised;
+      begin_frame(r, input, colliders, fresh);
+      if (!fresh) simulate(r, input, colliders);
+      if (rotations_out) write_output(r, rotations_out);
+    }
+  });
+}
+
+Vec3List RodSystem::joint_positions(std::size_t r) const {
+  const RodState& s = states_.at(r);
+  if (!s.initialised) return {};
+  return Vec3List(s.x.begin() + 1, s.x.end());
+}
+
+Vec3List RodSystem::joint_velocities(std::size_t r) const {
+  const RodState& s = states_.at(r);
+  if (!s.initialised) return {};
+  return Vec3List(s.v.begin() + 1, s.v.end());
+}
+
+namespace {
+
+struct Writer {
+  std::vector<Real>& out;
+  void put(Real v) { out.push_back(v); }
+  void put(const Vec3& v) { out.insert(out.end(), {v.x(), v.y(), v.z()}); }
+  void put(const Quat& q) { out.insert(out.end(), {q.w(), q.x(), q.y(), q.z()}); }
+};
+
+struct Reader {
+  const std::vector<Real>& in;
+  std::size_t at = 0;
+  Real real() { return in.at(at++); }
+  Vec3 vec() { const Vec3 v(in.at(at), in.at(at + 1), in.at(at + 2)); at += 3; return v; }
+  Quat quat() { const Quat q(in.at(at), in.at(at + 1), in.at(at + 2), in.at(at + 3)); at += 4; return q; }
+};
+
+}  // namespace
+
+std::size_t RodSystem::state_size() const {
+  std::size_t size = 0;
+  for (std::size_t r = 0; r < rods_.size(); ++r) {
+    const std::size_t n = rods_[r].bones.size();
+    size += 1 + (n + 2) * (3 + 3 + 4 + 3) + n * 8 + 3 + 4 + 3 + 2 + weights_[r].size();
+  }
+  return size;
+}
+
+std::vector<Real> RodSystem::save_state() const {
+  std::vector<Real> out;
+  out.reserve(state_size());
+  Writer w{out};
+  for (std::size_t r = 0; r < rods_.size(); ++r) {
+    const RodState& s = states_[r];
+    const std::size_t n = rods_[r].bones.size();
+    w.put(s.initialised ? 1.0 : 0.0);
+    for (std::size_t j = 0; j < n + 2; ++j) {
+      w.put(s.initialised ? s.x[j] : Vec3::Zero());
+      w.put(s.initialised ? s.v[j] : Vec3::Zero());
+      w.put(s.initialised ? s.q[j] : Quat::Identity());
+      w.put(s.initialised ? s.omega[j] : Vec3::Zero());
+    }
+    for (std::size_t k = 0; k < n; ++k) {
+      w.put(s.initialised ? s.rest_local[k] : Quat::Identity());
+      w.put(s.initialised ? s.last_output[k] : Quat::Identity());
+    }
+    w.put(s.anchor_position);
+    w.put(s.anchor_rotation);
+    w.put(s.reference_position);
+    w.put(s.time_accumulator);
+    w.put(s.speed);
+    for (Real v : weights_[r]) w.put(v);
+  }
+  return out;
+}
+
+void RodSystem::load_state(const std::vector<Real>& state) {
+  if (state.size() != state_size()) {
+    throw std::invalid_argument("state has " + std::to_string(state.size()) + " values, this system needs " +
+                                std::to_string(state_size()));
+  }
+  Reader rd{state};
+  for (std::size_t r = 0; r < rods_.size(); ++r) {
+    RodState& s = states_[r];
+    const std::size_t n = rods_[r].bones.size();
+    s.initialised = rd.real() != 0;
+    s.x.resize(n + 2);
+    s.v.resize(n + 2);
+    s.q.resize(n + 2);
+    s.omega.resize(n + 2);
+    s.prev_x.resize(n + 2);
+    s.prev_q.resize(n + 2);
+    s.rest_local.resize(n);
+    s.last_output.resize(n);
+    for (std::size_t j = 0; j < n + 2; ++j) {
+      s.x[j] = rd.vec();
+      s.v[j] = rd.vec();
+      s.q[j] = rd.quat();
+      s.omega[j] = rd.vec();
+    }
+    for (std::size_t k = 0; k < n; ++k) {
+      s.rest_local[k] = rd.quat();
+      s.last_output[k] = rd.quat();
+    }
+    s.anchor_position = rd.vec();
+    s.anchor_rotation = rd.quat();
+    s.reference_position = rd.vec();
+    s.time_accumulator = rd.real();
+    s.speed = rd.real();
+    for (Real& v : weights_[r]) v = rd.real();
+  }
+}
+
+}  // namespace kodawari::rod
