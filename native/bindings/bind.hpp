@@ -5,4 +5,5 @@
 
 namespace kodawari::bind {
 // void bind_<area>(pybind11::module_& m);  declared here as each area lands
+void bind_gait(pybind11::module_& m);
 }  // namespace kodawari::bind

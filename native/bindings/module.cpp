@@ -13,4 +13,5 @@ PYBIND11_MODULE(kodawari_native, m) {
   m.attr("__version__") = kodawari::core_version();
   // The add-on compares this with its own version to refuse a stale build.
   m.attr("PYTHON_ABI") = PY_MAJOR_VERSION * 100 + PY_MINOR_VERSION;
+  kodawari::bind::bind_gait(m);
 }

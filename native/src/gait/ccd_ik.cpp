@@ -1,0 +1,125 @@
+#include "kodawari/gait/ccd_ik.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace kodawari::gait {
+
+namespace {
+constexpr int kMaxBones = 6;
+
+Real cross2(const Vec2& a, const Vec2& b) { return a.x() * b.y() - a.y() * b.x(); }
+}  // namespace
+
+Real LegChain::length() const {
+  Real total = 0;
+  for (Real l : lengths) total += l;
+  return total;
+}
+
+void chain_points(const LegChain& chain, const Real* angles, Vec2* points) {
+  points[0] = chain.root;
+  Real turned = 0;
+  for (int k = 0; k < chain.size(); ++k) {
+    turned += angles[k];
+    // Positive pose angles turn clockwise in (f, u): see LegChain.
+    const Real direction = chain.rest_direction[k] - turned;
+    points[k + 1] = points[k] + chain.lengths[k] * Vec2(std::cos(direction), std::sin(direction));
+  }
+}
+
+Vec2 chain_foot(const LegChain& chain, const Real* angles) {
+  Vec2 points[kMaxBones + 1];
+  chain_points(chain, angles, points);
+  return points[chain.size()];
+}
+
+namespace {
+// `iterations` sweeps of CCD from the last bone up; each joint takes `share` of the
+// turn that points the line joint -> foot at the target, then is clamped.
+CcdResult ccd_sweeps(const LegChain& chain, const Vec2& target, int iterations, Real tolerance, bool use_stiffness,
+                     Real* angles) {
+  const int n = chain.size();
+  Vec2 points[kMaxBones + 1];
+  chain_points(chain, angles, points);
+  CcdResult result;
+  result.error = (points[n] - target).norm();
+  for (int it = 0; it < iterations && result.error > tolerance; ++it) {
+    for (int k = n - 1; k >= 0; --k) {
+      const Vec2 to_foot = points[n] - points[k];
+      const Vec2 to_target = target - points[k];
+      if (to_foot.squaredNorm() < 1e-18 || to_target.squaredNorm() < 1e-18) continue;
+      const Real turn_ccw = std::atan2(cross2(to_foot, to_target), to_foot.dot(to_target));
+      const Real share = use_stiffness ? chain.stiffness[k] : Real(1);
+      const Real clamped = std::clamp(angles[k] - share * turn_ccw, chain.limit_min[k], chain.limit_max[k]);
+      const Real applied = clamped - angles[k];
+      if (applied == 0) continue;
+      angles[k] = clamped;
+      // Rotate the points below joint k about it (clockwise by `applied`).
+      const Real c = std::cos(applied), s = std::sin(applied);
+      for (int j = k + 1; j <= n; ++j) {
+        const Vec2 d = points[j] - points[k];
+        points[j] = points[k] + Vec2(c * d.x() + s * d.y(), -s * d.x() + c * d.y());
+      }
+    }
+    const Real previous = result.error;
+    result.error = (points[n] - target).norm();
+    result.iterations = it + 1;
+    if (result.error > previous * 0.999) break;  // stalled: limits hold it, more sweeps will not help
+  }
+  chain_points(chain, angles, points);
+  result.error = (points[n] - target).norm();
+  return result;
+}
+}  // namespace
+
+CcdResult solve_ccd(const LegChain& chain, const Vec2& target, int iterations, Real tolerance, Real* angles,
+                    bool allow_restart) {
+  const int n = chain.size();
+  for (int k = 0; k < n; ++k) {
+    angles[k] = std::isfinite(angles[k]) ? std::clamp(angles[k], chain.limit_min[k], chain.limit_max[k])
+                                         : std::clamp(Real(0), chain.limit_min[k], chain.limit_max[k]);
+  }
+  // The seed's CCD with joint stiffness shapes the pose (the femur leads, not the hoof).
+  CcdResult result = ccd_sweeps(chain, target, iterations, tolerance, true, angles);
+  if (result.error <= tolerance) return result;
+  // Stiffness slows convergence; when it stalls, plain CCD closes the remaining gap
+  // from that pose, so a reachable planted foot is really reached.
+  Real polished[kMaxBones];
+  std::copy(angles, angles + n, polished);
+  CcdResult polish = ccd_sweeps(chain, target, iterations, tolerance, false, polished);
+  polish.iterations += result.iterations;
+  if (polish.error < result.error) {
+    std::copy(polished, polished + n, angles);
+    result = polish;
+  }
+  if (result.error <= tolerance) return result;
+  // A warm start can sit in a corner of the limits; cold starts from the rest pose and
+  // from the middle of the limits find the other branches. Keep whichever lands
+  // closest: the foot then moves by at most the warm start's miss.
+  for (int seed = 0; allow_restart && seed < 2 && result.error > std::max(tolerance, Real(1e-3)); ++seed) {
+    Real cold[kMaxBones];
+    for (int k = 0; k < n; ++k) {
+      cold[k] = seed == 0 ? std::clamp(Real(0), chain.limit_min[k], chain.limit_max[k])
+                          : (chain.limit_min[k] + chain.limit_max[k]) / 2;
+    }
+    CcdResult again = ccd_sweeps(chain, target, iterations, tolerance, true, cold);
+    if (again.error > tolerance) again = ccd_sweeps(chain, target, iterations, tolerance, false, cold);
+    if (again.error < result.error - 1e-4) {
+      std::copy(cold, cold + n, angles);
+      again.iterations += result.iterations;
+      result = again;
+    }
+  }
+  return result;
+}
+
+Real directional_reach(const LegChain& chain, const Vec2& direction) {
+  std::vector<Real> angles(chain.size());
+  for (int k = 0; k < chain.size(); ++k) angles[k] = std::clamp(Real(0), chain.limit_min[k], chain.limit_max[k]);
+  const Vec2 far = chain.root + direction * (4 * chain.length());
+  solve_ccd(chain, far, 64, 0, angles.data());
+  return std::max(Real(0), (chain_foot(chain, angles.data()) - chain.root).dot(direction));
+}
+
+}  // namespace kodawari::gait
