@@ -104,3 +104,37 @@ def write_channels(action, id_block, data_path, frames, values, group="", interp
         write_keys(fcurve, frames, np.ascontiguousarray(values[:, index]), interpolation)
         curves.append(fcurve)
     return curves
+
+
+def read_keys(fcurve):
+    """(frames, values) of an F-curve's keys as float32 arrays, in one bulk read."""
+    points = fcurve.keyframe_points
+    co = np.empty(2 * len(points), dtype=np.float32)
+    points.foreach_get("co", co)
+    return co[0::2].copy(), co[1::2].copy()
+
+
+def current_slot_identifier(id_block):
+    """The identifier of the action slot id_block uses (None before 4.4 or when unset)."""
+    anim = id_block.animation_data
+    if not _SLOTTED or anim is None or anim.action_slot is None:
+        return None
+    return anim.action_slot.identifier
+
+
+def assign_action(id_block, action, slot_identifier=None):
+    """Make `action` animate id_block, on the slot with slot_identifier when given
+    (4.4+), else on its only slot, else a new one. action=None unassigns."""
+    anim = id_block.animation_data or id_block.animation_data_create()
+    anim.action = action
+    if action is None or not _SLOTTED:
+        return
+    slot = None
+    for candidate in action.slots:
+        if slot_identifier is not None and candidate.identifier == slot_identifier:
+            slot = candidate
+    if slot is None and slot_identifier is None and len(action.slots) == 1:
+        slot = action.slots[0]
+    if slot is None:
+        slot = action.slots.new(id_type=id_block.id_type, name=id_block.name)
+    anim.action_slot = slot

@@ -34,7 +34,7 @@ GaitTable horse_gait_table() {
   // WALK and TROT: the seed's numbers (P = 0.3 s; alpha 0.7, 0.5; phases (0.2, 0.5),
   // (0.5, 0.5)). Trot at 5 m/s strides 3.0 m (measured 3.04 m).
   t.gaits[0] = make(0.7, 0.2, 0.5, 0.3, 0.12, 0.45, 0.02, 2, 1.9, true);
-  t.gaits[1] = make(0.5, 0.5, 0.5, 0.3, 0.18, 0.40, 0.04, 2, 4.8, true);
+  t.gaits[1] = make(0.5, 0.5, 0.5, 0.3, 0.18, 0.40, 0.04, 2, 5.0, true);
   // CANTER: the seed's P = 0.3 s, alpha = 0.3 give a 2.14 m stride at 5 m/s where
   // horses measure 2.68 m. We keep the seed's principle (swing time constant, stance
   // absorbs speed) with the literature's swing of 0.33 s and raise the duty factor to

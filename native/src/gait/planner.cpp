@@ -15,7 +15,7 @@ using Vec2d = Eigen::Matrix<Real, 2, 1>;
 
 constexpr Real kSubstepRate = 480;   // planner grid, Hz: events land within ~2 ms
 constexpr Real kEaseMax = 0.1;       // most of a swing spent speeding up / slowing down
-constexpr Real kEaseLag = 0.06;      // m: how far a foot may lag (or lead) its root while it eases
+constexpr Real kEaseLag = 0.03;      // m: how far a foot may lag (or lead) its root while it eases
 constexpr Real kStandSpeed = 1e-4;   // below this the clocks of planted legs pause
 constexpr Real kReachMargin = 0.93;  // IK targets stay inside 93% of what the chain reaches
 constexpr int kReachSamples = 64;
