@@ -12,7 +12,7 @@ HIND = ((0.40, 60.0), (0.42, -25.0), (0.40, 35.0), (0.50, -5.0))   # pelvis, fem
 # relative to straight down), widened where the seed's snapshot ranges cannot reach
 # the seed's own +-0.8 m (see README).
 FORE_LIMITS = ((-55, -15), (60, 100), (-135, -5), (0, 120))
-HIND_LIMITS = ((40, 75), (-110, -55), (10, 110), (-135, -5))
+HIND_LIMITS = ((40, 75), (-125, -55), (10, 125), (-135, 0))
 STIFFNESS = (0.1, 0.3, 0.5, 1.0)
 
 

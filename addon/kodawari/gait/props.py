@@ -73,7 +73,7 @@ class KodawariGaitSettings(bpy.types.PropertyGroup):
                                    min=0.05, max=1.0)
     legs: bpy.props.CollectionProperty(type=KodawariGaitLeg)
     body_bone: bpy.props.StringProperty(name="Body Bone", description="The bone carrying root motion")
-    ccd_iterations: bpy.props.IntProperty(name="CCD Iterations", default=40, min=1, max=1000)
+    ccd_iterations: bpy.props.IntProperty(name="CCD Iterations", default=64, min=1, max=1000)
     acceleration: bpy.props.FloatProperty(name="Acceleration", description="Largest change of speed, m/s²",
                                           default=3.0, min=0.01, max=1000.0)
     ground: bpy.props.PointerProperty(name="Ground", type=bpy.types.Object,

@@ -18,7 +18,7 @@ _HIND = re.compile(r"hind|back|rear", re.IGNORECASE)
 # relative to straight down, positive swinging the tip backward), widened where the
 # seed's gallop snapshot cannot reach its own +-0.8 m (scapula +-3 deg, humerus +-1 deg).
 HORSE_FORE_LIMITS = ((-55.0, -15.0), (60.0, 100.0), (-135.0, -5.0), (0.0, 120.0))
-HORSE_HIND_LIMITS = ((40.0, 75.0), (-110.0, -55.0), (10.0, 110.0), (-135.0, -5.0))
+HORSE_HIND_LIMITS = ((40.0, 75.0), (-125.0, -55.0), (10.0, 125.0), (-135.0, 0.0))
 HORSE_STIFFNESS = (0.1, 0.3, 0.5, 1.0)
 
 

@@ -97,11 +97,15 @@ CcdResult solve_ccd(const LegChain& chain, const Vec2& target, int iterations, R
   // A warm start can sit in a corner of the limits; cold starts from the rest pose and
   // from the middle of the limits find the other branches. Keep whichever lands
   // closest: the foot then moves by at most the warm start's miss.
-  for (int seed = 0; allow_restart && seed < 2 && result.error > std::max(tolerance, Real(1e-3)); ++seed) {
+  const std::vector<Real> warm(angles, angles + n);
+  for (int seed = 0; allow_restart && seed < 3 && result.error > std::max(tolerance, Real(1e-3)); ++seed) {
     Real cold[kMaxBones];
     for (int k = 0; k < n; ++k) {
-      cold[k] = seed == 0 ? std::clamp(Real(0), chain.limit_min[k], chain.limit_max[k])
-                          : (chain.limit_min[k] + chain.limit_max[k]) / 2;
+      const Real middle = (chain.limit_min[k] + chain.limit_max[k]) / 2;
+      const bool at_limit = warm[k] <= chain.limit_min[k] + 1e-6 || warm[k] >= chain.limit_max[k] - 1e-6;
+      if (seed == 0) cold[k] = at_limit ? middle : warm[k];  // free the joints stuck on a limit
+      else if (seed == 1) cold[k] = std::clamp(Real(0), chain.limit_min[k], chain.limit_max[k]);
+      else cold[k] = middle;
     }
     CcdResult again = ccd_sweeps(chain, target, iterations, tolerance, true, cold);
     if (again.error > tolerance) again = ccd_sweeps(chain, target, iterations, tolerance, false, cold);

@@ -43,7 +43,7 @@ Real swing_ease(Real v, Real swing_time) {
   const Real t = v > 1e-6 ? kEaseLag / (0.65 * v) : swing_time;
   return std::clamp(t / swing_time, Real(0.01), kEaseMax);
 }
-Real ease_lag(Real v, Real swing_time) { return 0.65 * v * swing_ease(v, swing_time) * swing_time + 0.01; }
+Real ease_lag(Real v, Real swing_time) { return v * swing_ease(v, swing_time) * swing_time + 0.015; }
 
 // Swing height profile: 0 at both ends with zero vertical speed, 1 at `peak`.
 Real swing_lift(Real s, Real peak) {
