@@ -43,5 +43,15 @@ def horse_rig():
     legs = [leg((0.12, -0.55, fore_z), FORE, FORE_LIMITS), leg((-0.12, -0.55, fore_z), FORE, FORE_LIMITS),
             leg((0.14, 0.55, hind_z), HIND, HIND_LIMITS), leg((-0.14, 0.55, hind_z), HIND, HIND_LIMITS)]
     return {"forward": np.array([0.0, -1.0, 0.0]), "body_head": np.array([0.0, 0.0, 1.4]),
-            "body_rest": np.array([[1.0, 0, 0], [0, 0, 1.0], [0, -1.0, 0]]),  # bone Y axis along -Y? see below
+            # the body bone points forward (-Y): its rest matrix's columns are its X, Y, Z axes
+            "body_rest": np.array([[1.0, 0, 0], [0, -1.0, 0], [0, 0, -1.0]]),
             "legs": legs}
+
+
+def neutral(rig):
+    return np.array([np.dot(leg["tail"] - leg["heads"][0], rig["forward"]) for leg in rig["legs"]])
+
+
+def limits(rig):
+    return (np.concatenate([leg["limit_min"] for leg in rig["legs"]]),
+            np.concatenate([leg["limit_max"] for leg in rig["legs"]]))

@@ -307,12 +307,12 @@ BakeOutput bake_gait(const BakeInput& in) {
     {
       // At speed the reach caps how long a stance can last (2 x margin of travel). A
       // phase shift the stance cannot absorb is taken by this swing, stretched by at
-      // most a quarter (the rest waits for the next stride).
+      // most a half (the rest waits for the next stride).
       const Real v = std::max(speed[clamp_step(p.touchdown)], Real(1e-6));
       const Real longest = 2 * (reach[leg] - swing_margin(v, g)) / v / dt;
       const long excess = static_cast<long>(std::floor(p.next_stance - longest));
       if (excess > 0) {
-        const long stretch = std::min(excess, p.swing_length / 4);
+        const long stretch = std::min(excess, p.swing_length / 2);
         p.swing_length += stretch;
         p.touchdown += stretch;
         p.next_stance = plan_stance(leg, p.touchdown);
