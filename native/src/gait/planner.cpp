@@ -15,7 +15,7 @@ using Vec2d = Eigen::Matrix<Real, 2, 1>;
 
 constexpr Real kSubstepRate = 480;   // planner grid, Hz: events land within ~2 ms
 constexpr Real kEaseMax = 0.1;       // most of a swing spent speeding up / slowing down
-constexpr Real kEaseLag = 0.03;      // m: how far a foot may lag (or lead) its root while it eases
+constexpr Real kEaseLag = 0.02;      // m: how far a foot may lag (or lead) its root while it eases
 constexpr Real kStandSpeed = 1e-4;   // below this the clocks of planted legs pause
 constexpr Real kReachMargin = 0.93;  // IK targets stay inside 93% of what the chain reaches
 constexpr int kReachSamples = 64;
@@ -43,7 +43,7 @@ Real swing_ease(Real v, Real swing_time) {
   const Real t = v > 1e-6 ? kEaseLag / (0.65 * v) : swing_time;
   return std::clamp(t / swing_time, Real(0.01), kEaseMax);
 }
-Real ease_lag(Real v, Real swing_time) { return v * swing_ease(v, swing_time) * swing_time + 0.015; }
+Real ease_lag(Real v, Real swing_time) { return v * swing_ease(v, swing_time) * swing_time + 0.008; }
 
 // Swing height profile: 0 at both ends with zero vertical speed, 1 at `peak`.
 Real swing_lift(Real s, Real peak) {
