@@ -68,8 +68,9 @@ def test_finds_legs_from_four_selected_feet(empty_scene):
             rig.data.bones[old].name = new
     feet = [names[n] for n in ("fore_cannon.L", "fore_cannon.R", "hind_cannon.L", "hind_cannon.R")]
     bpy.ops.object.mode_set(mode="POSE")
-    for bone in rig.data.bones:
-        bone.select = bone.name in feet
+    for pose_bone in rig.pose.bones:
+        owner = pose_bone if hasattr(pose_bone, "select") else pose_bone.bone  # 5.0 moved selection
+        owner.select = pose_bone.name in feet
     assert bpy.ops.kodawari.gait_setup() == {"FINISHED"}
     bpy.ops.object.mode_set(mode="OBJECT")
     legs = {leg.name: [b.name for b in leg.bones] for leg in rig.kodawari_gait.legs}

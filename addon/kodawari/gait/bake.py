@@ -37,8 +37,10 @@ def _path_points(context, obj, path_obj):
         evaluated.to_mesh_clear()
     if n < 2:
         raise ValueError(f"the path curve '{path_obj.name}' has no length")
-    to_arm = np.array(obj.matrix_world.inverted() @ path_obj.matrix_world, dtype=np.float64)
-    pts = co.reshape(-1, 3) @ to_arm[:3, :3].T + to_arm[:3, 3]
+    to_arm = obj.matrix_world.inverted() @ path_obj.matrix_world
+    rotation = rigmod.mat3(to_arm)
+    offset = np.array([float(to_arm[i][3]) for i in range(3)])
+    pts = co.reshape(-1, 3) @ rotation.T + offset
     return np.ascontiguousarray(pts)
 
 

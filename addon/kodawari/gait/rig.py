@@ -22,6 +22,12 @@ HORSE_HIND_LIMITS = ((40.0, 75.0), (-125.0, -55.0), (10.0, 125.0), (-135.0, 0.0)
 HORSE_STIFFNESS = (0.1, 0.3, 0.5, 1.0)
 
 
+def mat3(matrix):
+    """A mathutils 3x3 (or the 3x3 of a 4x4) as a C-ordered float64 array, row by row
+    (np.array(Matrix) changed memory order between Blender versions)."""
+    return np.array([[float(matrix[i][j]) for j in range(3)] for i in range(3)], dtype=np.float64)
+
+
 def side_of(name):
     if _LEFT.search(name):
         return "L"
@@ -210,7 +216,7 @@ def rig_dict(obj, settings):
     chains = {k: [b.name for b in legs[k].bones] for k in LEG_NAMES}
     forward = forward_of(armature, chains)
     body = armature.bones[settings.body_bone]
-    rest = np.array(body.matrix_local.to_3x3().normalized(), dtype=np.float64)
+    rest = mat3(body.matrix_local.to_3x3().normalized())
     rig = {"forward": forward, "body_head": np.array(body.head_local, dtype=np.float64), "body_rest": rest,
            "legs": [], "reach_fraction": float(settings.reach)}
     for k in LEG_NAMES:
@@ -234,7 +240,7 @@ def hinge_axes(obj, chains, forward):
     axes = {}
     for k in LEG_NAMES:
         for name in chains[k]:
-            m = np.array(obj.data.bones[name].matrix_local.to_3x3().normalized(), dtype=np.float64)
+            m = mat3(obj.data.bones[name].matrix_local.to_3x3().normalized())
             a = m.T @ lateral
             axes[name] = a / np.linalg.norm(a)
     return axes
