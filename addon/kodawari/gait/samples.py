@@ -62,11 +62,16 @@ def build_rig(name, scene, fore, hind, fore_y, hind_y, fore_x, hind_x, body_z, n
              for y in np.linspace(hind_y * 1.25, fore_y * 1.3, 6)]
     for a, b in zip(spine[:-1], spine[1:]):
         skeleton["edges"].append((a, b))
-    for bone_name, head, tail, radius, parent_vertex in extra:
+    tails = {}
+    for bone_name, head, tail, radius, parent in extra:
+        # parent: a spine vertex index, or the name of an earlier extra bone to chain to
         bone = eb.new(bone_name)
-        bone.head, bone.tail, bone.parent = head, tail, body
-        v0 = spine[parent_vertex]
+        bone.head, bone.tail = head, tail
+        bone.parent = eb[parent] if isinstance(parent, str) else body
+        bone.use_connect = isinstance(parent, str)
+        v0 = tails[parent] if isinstance(parent, str) else spine[parent]
         v1 = add_vertex(tail, bone_name, radius)
+        tails[bone_name] = v1
         skeleton["edges"].append((v0, v1))
     for side, sign in (("L", 1.0), ("R", -1.0)):
         for word, bones, y, x in ((fore_word, fore, fore_y, fore_x), (hind_word, hind, hind_y, hind_x)):
@@ -115,8 +120,8 @@ def build_rig(name, scene, fore, hind, fore_y, hind_y, fore_x, hind_x, body_z, n
 
 def build_horse(scene, name="Horse"):
     """A Thoroughbred: withers ~1.5 m, 4 bones per leg named fore_*.L / hind_*.R."""
-    extra = (("neck", (0.0, -0.7, 1.5), (0.0, -1.05, 1.95), 0.14, 5),
-             ("head", (0.0, -1.05, 1.95), (0.0, -1.45, 1.65), 0.1, 5),
+    extra = (("neck", (0.0, -0.66, 1.5), (0.0, -1.05, 1.95), 0.14, 5),
+             ("head", (0.0, -1.05, 1.95), (0.0, -1.5, 1.62), 0.1, "neck"),
              ("tail", (0.0, 0.7, 1.45), (0.0, 1.05, 1.05), 0.05, 0))
     rig, body = build_rig(name, scene, HORSE_FORE, HORSE_HIND, -0.55, 0.55, 0.12, 0.14, 1.45,
                           ("fore", "hind", ".{}", "body"), (0.32, 0.085, 0.045), extra)
@@ -126,7 +131,7 @@ def build_horse(scene, name="Horse"):
 def build_dog(scene, name="Dog"):
     """A small dog: 3 bones per leg named front_*_L / back_*_R (other naming on purpose)."""
     extra = (("neck", (0.0, -0.25, 0.55), (0.0, -0.38, 0.72), 0.06, 5),
-             ("head", (0.0, -0.38, 0.72), (0.0, -0.55, 0.66), 0.05, 5),
+             ("head", (0.0, -0.38, 0.72), (0.0, -0.55, 0.66), 0.05, "neck"),
              ("tail", (0.0, 0.28, 0.52), (0.0, 0.5, 0.6), 0.02, 0))
     return build_rig(name, scene, DOG_FRONT, DOG_BACK, -0.22, 0.22, 0.07, 0.07, 0.55,
                      ("front", "back", "_{}", "spine"), (0.12, 0.035, 0.02), extra)
