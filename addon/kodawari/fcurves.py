@@ -138,3 +138,35 @@ def assign_action(id_block, action, slot_identifier=None):
     if slot is None:
         slot = action.slots.new(id_type=id_block.id_type, name=id_block.name)
     anim.action_slot = slot
+
+
+_KEY_VECTORS = ("co", "handle_left", "handle_right")
+_KEY_ENUMS = ("interpolation", "handle_left_type", "handle_right_type", "easing")
+
+
+def copy_keys(fcurve):
+    """Everything of an F-curve's keys (positions, handles, interpolation, easing) and
+    its extrapolation, read in bulk, for copy_into."""
+    points = fcurve.keyframe_points
+    n = len(points)
+    data = {"data_path": fcurve.data_path, "index": fcurve.array_index,
+            "group": fcurve.group.name if fcurve.group else "", "extrapolation": fcurve.extrapolation}
+    for name in _KEY_VECTORS:
+        data[name] = np.empty(2 * n, dtype=np.float32)
+        points.foreach_get(name, data[name])
+    for name in _KEY_ENUMS:
+        data[name] = np.empty(n, dtype=np.int32)
+        points.foreach_get(name, data[name])
+    return data
+
+
+def copy_into(action, id_block, data):
+    """Recreate an F-curve saved by copy_keys in `action` (animating id_block)."""
+    fcurve = ensure_fcurve(action, id_block, data["data_path"], data["index"], data["group"])
+    points = fcurve.keyframe_points
+    points.add(len(data["interpolation"]))
+    for name in _KEY_VECTORS + _KEY_ENUMS:
+        points.foreach_set(name, data[name])
+    fcurve.extrapolation = data["extrapolation"]
+    fcurve.update()
+    return fcurve

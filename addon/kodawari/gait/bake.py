@@ -108,12 +108,15 @@ class GaitBakeJob:
             raise ValueError(f"speed is negative ({speed[speed < 0][0]:.2f} m/s at frame {f}): "
                              "key speeds of 0 or more")
         length = rigmod.leg_length(self.rig)
-        for f, (v, g) in enumerate(zip(speed, mode)):
-            top = kn.gait_table_speed_max(self.table, int(g), length)
-            if v > top + 1e-6:
-                what = "the gait table" if g < 0 else GAIT_NAMES[int(g)]
-                raise ValueError(f"speed {v:.2f} m/s at frame {int(self.frames[f])} is past the range of {what} "
-                                 f"(top {top:.2f} m/s): lower it or raise the table's top speed")
+        tops = {int(g): kn.gait_table_speed_max(self.table, int(g), length) for g in np.unique(mode)}
+        top = np.array([tops[int(g)] for g in mode]) if len(tops) > 1 else np.full(len(mode), tops[int(mode[0])])
+        too_fast = speed > top + 1e-6
+        if too_fast.any():
+            f = int(np.argmax(too_fast))
+            g = int(mode[f])
+            what = "the gait table" if g < 0 else GAIT_NAMES[g]
+            raise ValueError(f"speed {speed[f]:.2f} m/s at frame {int(self.frames[f])} is past the range of {what} "
+                             f"(top {top[f]:.2f} m/s): lower it or raise the table's top speed")
         path = _path_points(context, obj, settings.path) if settings.path is not None else None
         args = (self.rig, self.table, np.ascontiguousarray(speed), np.ascontiguousarray(mode, dtype=np.float64),
                 float(self.fps), float(settings.acceleration), int(settings.ccd_iterations))
@@ -139,13 +142,28 @@ class GaitBakeJob:
         self._old_slot = fcurves.current_slot_identifier(obj)
         self._old_modes = {pb.name: pb.rotation_mode for pb in obj.pose.bones}
         self._old_props = {k: obj[k] for k in CONTACT_PROPS + (GAIT_PROP,) if k in obj.keys()}
+        # A new Action (the old one stays untouched until finish, so Esc can put it
+        # back); the curves this bake does not own (the speed keys, other bones) are
+        # copied over, the gait channels are written fresh.
+        owned = self._owned_paths()
+        kept = []
         if self._old_action is not None:
-            action = self._old_action.copy()  # the speed keys and anything else come along
-        else:
-            action = bpy.data.actions.new(f"{obj.name}Gait")
+            kept = [fcurves.copy_keys(c) for c in fcurves.action_fcurves(self._old_action, obj)
+                    if c.data_path not in owned]
+        action = bpy.data.actions.new(self._old_action.name if self._old_action else f"{obj.name}Gait")
         self.action = action
-        fcurves.assign_action(obj, action, self._old_slot)
+        fcurves.assign_action(obj, action, None)
+        for data in kept:
+            fcurves.copy_into(action, obj, data)
         self._started = True
+
+    def _owned_paths(self):
+        bones = [n for leg in LEG_NAMES for n in self.chains[leg]]
+        body = self.obj.kodawari_gait.body_bone
+        paths = {f'pose.bones["{n}"].rotation_quaternion' for n in bones + [body]}
+        paths.add(f'pose.bones["{body}"].location')
+        paths.update(f'["{p}"]' for p in CONTACT_PROPS + (GAIT_PROP,))
+        return paths
 
     def steps(self):
         """Write one channel group per step; yields the fraction done."""

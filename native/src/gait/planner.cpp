@@ -19,7 +19,7 @@ constexpr Real kEaseLag = 0.02;      // m: how far a foot may lag (or lead) its 
 constexpr Real kStandSpeed = 1e-4;   // below this the clocks of planted legs pause
 constexpr Real kReachMargin = 0.93;  // IK targets stay inside 93% of what the chain reaches
 constexpr int kReachSamples = 64;
-constexpr Real kIkTolerance = 2e-5;  // m: a planted foot is solved to well under a millimetre
+constexpr Real kIkTolerance = 2e-4;  // m: a planted foot is solved to a fifth of a millimetre
 constexpr int kMaxBones = 6;
 
 Vec3 up() { return Vec3(0, 0, 1); }
@@ -521,7 +521,22 @@ BakeOutput bake_gait(const BakeInput& in) {
       Real* angles = pose.data() + bone_offset[leg];
       const int n = chains[leg].size();
       Real previous[kMaxBones] = {};
+      Vec2d last_target(std::numeric_limits<Real>::quiet_NaN(), 0);
+      Real last_error = 0;
       for (int f = 0; f < frames; ++f) {
+        const Vec3& goal = planned[f * kLegCount + leg];
+        const Vec3 rest_goal = rotations[f].transpose() * (goal - heads[f]) + rig.body_head;
+        const Vec2d goal2(rest_goal.dot(F), rest_goal.z());
+        if (goal2 == last_target) {  // nothing moved (standing): keep the pose exactly
+          for (int c = 0; c < 3; ++c) out.feet_planned[(f * kLegCount + leg) * 3 + c] = goal[c];
+          out.ik_error[f * 4 + leg] = last_error;
+          for (int bone = 0; bone < n; ++bone) {
+            previous[bone] = angles[bone];
+            out.angles[static_cast<std::size_t>(f) * out.bones + bone_offset[leg] + bone] = angles[bone];
+          }
+          continue;
+        }
+        last_target = goal2;
         // Warm start from the previous frame (seed 3.2), carried on by its change from
         // the frame before: a planted foot's angles move smoothly, so this lands close.
         if (f >= 2) {
@@ -539,6 +554,7 @@ BakeOutput bake_gait(const BakeInput& in) {
         const CcdResult r = solve_ccd(chains[leg], Vec2d(local.dot(F), local.z()), in.ccd_iterations, kIkTolerance,
                                        angles, contact[f * kLegCount + leg] > 0);
         out.ik_error[f * 4 + leg] = r.error;
+        last_error = r.error;
         for (int bone = 0; bone < chains[leg].size(); ++bone) {
           out.angles[static_cast<std::size_t>(f) * out.bones + bone_offset[leg] + bone] = angles[bone];
         }
