@@ -161,6 +161,7 @@ class GaitBakeJob:
         bones = [n for leg in LEG_NAMES for n in self.chains[leg]]
         body = self.obj.kodawari_gait.body_bone
         paths = {f'pose.bones["{n}"].rotation_quaternion' for n in bones + [body]}
+        paths.update(f'pose.bones["{n}"].rotation_euler' for n in bones)
         paths.add(f'pose.bones["{body}"].location')
         paths.update(f'["{p}"]' for p in CONTACT_PROPS + (GAIT_PROP,))
         return paths
@@ -178,13 +179,22 @@ class GaitBakeJob:
         jobs += [("body", settings.body_bone, None), ("contacts", None, None)]
         for i, (kind, name, col) in enumerate(jobs):
             if kind == "bone":
-                obj.pose.bones[name].rotation_mode = "QUATERNION"
-                half = r["angles"][:, col] / 2
                 axis = self.axes[name]
-                quat = np.stack([np.cos(half), axis[0] * np.sin(half), axis[1] * np.sin(half),
-                                 axis[2] * np.sin(half)], axis=1)
-                fcurves.write_channels(action, obj, f'pose.bones["{name}"].rotation_quaternion', frames, quat,
-                                       group=name)
+                mode, sign = rigmod.hinge_channel(axis)
+                if mode == "X":
+                    # A hinge about the bone's own X axis: one Euler channel says it all.
+                    obj.pose.bones[name].rotation_mode = "XYZ"
+                    euler = np.zeros((len(frames), 3))
+                    euler[:, 0] = sign * r["angles"][:, col]
+                    fcurves.write_channels(action, obj, f'pose.bones["{name}"].rotation_euler', frames,
+                                           euler[:, :1], group=name)
+                else:
+                    obj.pose.bones[name].rotation_mode = "QUATERNION"
+                    half = r["angles"][:, col] / 2
+                    quat = np.stack([np.cos(half), axis[0] * np.sin(half), axis[1] * np.sin(half),
+                                     axis[2] * np.sin(half)], axis=1)
+                    fcurves.write_channels(action, obj, f'pose.bones["{name}"].rotation_quaternion', frames,
+                                           quat, group=name)
             elif kind == "body":
                 obj.pose.bones[name].rotation_mode = "QUATERNION"
                 fcurves.write_channels(action, obj, f'pose.bones["{name}"].location', frames,

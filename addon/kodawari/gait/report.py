@@ -46,6 +46,13 @@ def read_baked(obj):
     angles = []
     for leg in LEG_NAMES:
         for name in chains[leg]:
+            mode, sign = rigmod.hinge_channel(axes[name])
+            if mode == "X":
+                keys = _curve(action, obj, f'pose.bones["{name}"].rotation_euler', 0)
+                if keys is None or len(keys[0]) != n:
+                    raise ValueError(f"bone '{name}' has no baked rotation: bake the gait again")
+                angles.append(sign * keys[1].astype(np.float64))
+                continue
             q = []
             for i in range(4):
                 keys = _curve(action, obj, f'pose.bones["{name}"].rotation_quaternion', i)

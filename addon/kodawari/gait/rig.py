@@ -254,3 +254,11 @@ def leg_length(rig):
 
 def neutral_offsets(rig):
     return np.array([float((leg["tail"] - leg["heads"][0]) @ rig["forward"]) for leg in rig["legs"]])
+
+
+def hinge_channel(axis):
+    """How a hinge about `axis` (unit, in the bone's rest space) is keyed: ("X", sign)
+    when it is the bone's own X axis (one Euler channel), else ("QUATERNION", 0)."""
+    if abs(abs(float(axis[0])) - 1.0) < 1e-6:
+        return "X", (1.0 if axis[0] > 0 else -1.0)
+    return "QUATERNION", 0.0
