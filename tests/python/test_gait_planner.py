@@ -81,6 +81,20 @@ def test_speed_ramp_through_every_gait_is_smooth():
     assert np.isfinite(out["angles"]).all()
 
 
+def test_auto_by_froude_number_walks_then_trots_at_the_froude_edge():
+    fps = 24
+    table = kn.gait_horse_table()
+    table["use_froude"] = True
+    table["hysteresis"] = 0.0
+    t = np.arange(10 * fps) / fps
+    out, rig = bake(np.interp(t, [0, 10], [0.5, 4.0]), -1, fps, table=table)
+    first_trot = np.argmax(out["gait"] == TROT)
+    leg_length = max(leg["heads"][0][2] - leg["tail"][2] for leg in rig["legs"][2:])
+    froude = out["speed"][first_trot] ** 2 / (9.81 * leg_length)
+    assert (out["gait"][:first_trot] == WALK).all()
+    assert froude == pytest.approx(table["gaits"][WALK][9], abs=0.02)
+
+
 def test_transition_completes_within_two_strides():
     fps = 240
     n = 8 * fps

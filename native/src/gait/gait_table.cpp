@@ -91,22 +91,18 @@ Real table_speed_max(const GaitTable& table, int gait, Real leg_length) {
 
 Gait select_gait(const GaitTable& table, Real speed, int current, Real leg_length) {
   int nominal = -1, last_auto = -1;
-  Real lower_of_current = 0, lower = 0;
-  bool current_is_auto = false;
+  Real lower = 0;  // top of the previous AUTO gait's band
   for (int g = 0; g < kGaitCount; ++g) {
     if (!table.gaits[g].use_in_auto) continue;
     const Real top = band_top(table, static_cast<Gait>(g), leg_length);
-    if (g == current) {
-      current_is_auto = true;
-      lower_of_current = lower;
-      if (speed >= lower - table.hysteresis && speed <= top + table.hysteresis) return static_cast<Gait>(g);
+    // Hysteresis: the current gait holds until the speed is past its band by this much.
+    if (g == current && speed >= lower - table.hysteresis && speed <= top + table.hysteresis) {
+      return static_cast<Gait>(g);
     }
     if (nominal < 0 && speed <= top) nominal = g;
     last_auto = g;
     lower = top;
   }
-  (void)lower_of_current;
-  (void)current_is_auto;
   if (nominal < 0) nominal = last_auto < 0 ? 0 : last_auto;
   return static_cast<Gait>(nominal);
 }
