@@ -50,12 +50,13 @@ def stance_slide(feet, contacts, leg, lo, hi):
 
 
 def swing_smoothness(feet, contacts, leg, lo, hi, fps):
-    """(largest step ratio, largest acceleration m/s^2) of the swinging foot.
+    """(largest jump m, largest jump ratio, largest acceleration m/s^2) of the swinging foot.
 
-    The step ratio is the largest one-frame move divided by the swing's mean one-frame
-    move: a smooth eased swing stays well under 2, a jump stands out."""
+    A jump is a one-frame move that stands out from both neighbouring moves: its ratio
+    is step / max(previous step, next step), about 1 on a smooth path whatever the
+    frame rate, and the jump is by how much the step exceeds them."""
     c = contacts[:, leg] > 0.5
-    ratio, accel = 0.0, 0.0
+    jump, ratio, accel = 0.0, 0.0, 0.0
     f = lo
     while f < hi:
         if c[f]:
@@ -68,12 +69,13 @@ def swing_smoothness(feet, contacts, leg, lo, hi, fps):
         path = feet[a:b, leg]
         if len(path) >= 3:
             steps = np.linalg.norm(np.diff(path, axis=0), axis=1)
-            mean = steps.mean()
-            if mean > 1e-9:
-                ratio = max(ratio, float(steps.max() / mean))
+            padded = np.concatenate([[0.0], steps, [0.0]])
+            neighbours = np.maximum(padded[:-2], padded[2:])
+            jump = max(jump, float((steps - neighbours).max()))
+            ratio = max(ratio, float((steps / np.maximum(neighbours, 1e-3)).max()))
             accel = max(accel, float(np.linalg.norm(np.diff(path, 2, axis=0), axis=1).max() * fps * fps))
         f = g
-    return ratio, accel
+    return jump, ratio, accel
 
 
 def measure(feet, roots, headings, contacts, gait, angles, limit_min, limit_max, neutral, reach, fps):
@@ -91,10 +93,11 @@ def measure(feet, roots, headings, contacts, gait, angles, limit_min, limit_max,
         cycle = float(np.mean(np.diff(lh_lifts))) if len(lh_lifts) >= 2 else None
         seg["cycle_time"] = cycle / fps if cycle else None
         for leg, name in enumerate(LEGS):
-            ratio, accel = swing_smoothness(feet, contacts, leg, lo, hi, fps)
+            jump, ratio, accel = swing_smoothness(feet, contacts, leg, lo, hi, fps)
             entry = {
                 "largest_stance_slide": stance_slide(feet, contacts, leg, lo, hi),
-                "largest_swing_step_ratio": ratio,
+                "largest_swing_jump": jump,
+                "largest_swing_jump_ratio": ratio,
                 "largest_swing_acceleration": accel,
                 "largest_foot_root_distance": float(np.abs(offsets[lo:hi, leg]).max()),
                 "reach": float(reach[leg]),
@@ -116,7 +119,8 @@ def measure(feet, roots, headings, contacts, gait, angles, limit_min, limit_max,
             seg["legs"][name] = entry
         seg["joint_limit_violations"] = int(outside[lo:hi].sum())
         seg["largest_stance_slide"] = max(e["largest_stance_slide"] for e in seg["legs"].values())
-        seg["largest_swing_step_ratio"] = max(e["largest_swing_step_ratio"] for e in seg["legs"].values())
+        seg["largest_swing_jump"] = max(e["largest_swing_jump"] for e in seg["legs"].values())
+        seg["largest_swing_jump_ratio"] = max(e["largest_swing_jump_ratio"] for e in seg["legs"].values())
         seg["largest_swing_acceleration"] = max(e["largest_swing_acceleration"] for e in seg["legs"].values())
         seg["largest_foot_root_distance"] = max(e["largest_foot_root_distance"] for e in seg["legs"].values())
         result.append(seg)
