@@ -136,6 +136,7 @@ def test_bake_is_deterministic(empty_scene):
     ("negative", "speed is negative"),
     ("too_fast", "past the range"),
     ("far_ground", "does not lie under"),
+    ("cliff", "out of the legs' reach"),
     ("one_bone", "needs 2 to 6"),
     ("no_body", "no body bone"),
 ])
@@ -159,6 +160,12 @@ def test_bad_input_is_refused_and_changes_nothing(empty_scene, case, message):
         ground = bpy.data.objects.new("Ground", bpy.data.meshes.new("Ground"))
         ground.data.from_pydata([(-1, -1, 0), (1, -1, 0), (1, 1, 0), (-1, 1, 0)], [], [(0, 1, 2, 3)])
         ground.location = (500.0, 0.0, 0.0)
+        empty_scene.collection.objects.link(ground)
+        s.ground = ground
+    elif case == "cliff":  # flat, then a 1.2 m wall up across the run
+        ground = bpy.data.objects.new("Cliff", bpy.data.meshes.new("Cliff"))
+        ground.data.from_pydata([(-5, 10, 0), (5, 10, 0), (5, -3, 0), (-5, -3, 0), (-5, -3, 1.2), (5, -3, 1.2),
+                                 (5, -60, 1.2), (-5, -60, 1.2)], [], [(0, 1, 2, 3), (3, 2, 5, 4), (4, 5, 6, 7)])
         empty_scene.collection.objects.link(ground)
         s.ground = ground
     elif case == "one_bone":
