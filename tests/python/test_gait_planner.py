@@ -208,3 +208,15 @@ def test_bad_arrays_raise_clear_errors():
     flat = horse_rig()
     flat["legs"][0]["tail"] = flat["legs"][0]["heads"][-1] + np.array([0.3, 0.0, 0.0])  # sideways: no length
     assert "zero length" in kn.gait_validate_rig(flat)
+
+
+def test_speed_changes_follow_the_acceleration_limit():
+    fps = 24
+    n = 8 * fps
+    target = np.where(np.arange(n) < fps, 1.0, 12.0)
+    rig, table = horse_rig(), kn.gait_horse_table()
+    out = kn.gait_bake(rig, table, target, np.full(n, -1.0), float(fps), 2.5, 32)
+    dv = np.diff(out["speed"]) * fps
+    assert dv.max() <= 2.5 + 1e-9  # never faster than the limit...
+    assert out["speed"][-1] == pytest.approx(12.0)  # ...and it gets there
+    assert np.argmax(out["speed"] >= 12.0 - 1e-9) / fps == pytest.approx(1 + 11 / 2.5, abs=0.1)
