@@ -131,7 +131,11 @@ def main():
     for obj, name in ((horse, "horse"), (dog, "dog")):
         bpy.context.view_layer.objects.active = obj
         bpy.ops.kodawari.gait_report(filepath=os.path.join(OUT, f"{name}_gait_report.png"))
-    bpy.ops.wm.save_as_mainfile(filepath=os.path.join(OUT, "horse.blend"))
+    blend = os.path.join(OUT, "horse.blend")
+    for stale in (blend, blend + "1"):  # no .blend1 backups in out/
+        if os.path.exists(stale):
+            os.remove(stale)
+    bpy.ops.wm.save_as_mainfile(filepath=blend)
     t = time.perf_counter()
     render_tiles(scene, shots)
     print(f"  rendered {len(shots)} tiles in {time.perf_counter() - t:.1f} s")
