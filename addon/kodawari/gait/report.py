@@ -144,7 +144,7 @@ def draw_report(data, fps, width=1400):
         x0, x1 = int(xs[lo]), int(xs[hi - 1]) + 1
         img[top:top + foot_h, x0:x1] = GAIT_COLORS[g]
         img[traj_top:traj_top + traj_h, x0:x1] = GAIT_COLORS[g]
-        if x1 - x0 > 60:
+        if x1 - x0 > 40:
             draw_text(img, x0 + 3, top - 14, metrics.GAITS[g].replace("GALLOP_ROTARY", "ROTARY"), black, 1)
     draw_text(img, left, 8, "FOOTFALLS (HILDEBRAND): BLACK = PLANTED", black, 2)
     for row, leg in enumerate((2, 0, 1, 3)):  # LH, LF, RF, RH
