@@ -1,4 +1,5 @@
 #include "kodawari/gait/planner.hpp"
+#include "kodawari/gait/swing_path.hpp"
 
 #include "kodawari/parallel.hpp"
 
@@ -13,8 +14,6 @@ namespace {
 using Vec2d = Eigen::Matrix<Real, 2, 1>;
 
 constexpr Real kSubstepRate = 480;   // planner grid, Hz: events land within ~2 ms
-constexpr Real kEaseMax = 0.1;       // most of a swing spent speeding up / slowing down
-constexpr Real kEaseLag = 0.02;      // m: how far a foot may lag (or lead) its root while it eases
 constexpr Real kStandSpeed = 1e-4;   // below this the clocks of planted legs pause
 constexpr Real kReachMargin = 0.93;  // IK targets stay inside 93% of what the chain reaches
 constexpr int kReachSamples = 64;
@@ -23,34 +22,6 @@ constexpr int kMaxBones = 6;
 
 Vec3 up() { return Vec3(0, 0, 1); }
 Vec2d horizontal(const Vec3& v) { return Vec2d(v.x(), v.y()); }
-
-// Swing progress along the ground: velocity rises from 0 over `ease` of the swing by a
-// half cosine, holds, and falls the same way, so the foot leaves and lands at rest
-// (no jump, no step in speed).
-Real swing_progress(Real s, Real ease) {
-  s = std::clamp(s, Real(0), Real(1));
-  auto ramp = [ease](Real x) { return x / 2 - ease / (2 * kPi) * std::sin(kPi * x / ease); };
-  const Real total = 1 - ease;
-  if (s <= ease) return ramp(s) / total;
-  if (s >= 1 - ease) return 1 - ramp(1 - s) / total;
-  return (ease / 2 + (s - ease)) / total;
-}
-
-// While a foot speeds up from rest its root runs on at v: the foot lags by about
-// 0.65 v t_ease. The ease is shortened at speed so the lag stays near kEaseLag.
-Real swing_ease(Real v, Real swing_time) {
-  const Real t = v > 1e-6 ? kEaseLag / (0.65 * v) : swing_time;
-  return std::clamp(t / swing_time, Real(0.01), kEaseMax);
-}
-Real ease_lag(Real v, Real swing_time) { return v * swing_ease(v, swing_time) * swing_time + 0.008; }
-
-// Swing height profile: 0 at both ends with zero vertical speed, 1 at `peak`.
-Real swing_lift(Real s, Real peak) {
-  s = std::clamp(s, Real(0), Real(1));
-  const Real gamma = std::log(0.5) / std::log(std::clamp(peak, Real(0.05), Real(0.95)));
-  const Real q = std::pow(s, gamma);
-  return 16 * q * q * (1 - q) * (1 - q);
-}
 
 struct Frame2 {  // body pose on the ground plane at one planner step
   Vec2d head;
