@@ -114,3 +114,69 @@ def remove_fcurve(action, id_block, fcurve):
     bag = _channelbag(action, id_block, create=False)
     if bag is not None:
         bag.fcurves.remove(fcurve)
+
+
+def read_keys(fcurve):
+    """(frames, values) of an F-curve's keys as float32 arrays, in one bulk read."""
+    points = fcurve.keyframe_points
+    co = np.empty(2 * len(points), dtype=np.float32)
+    points.foreach_get("co", co)
+    return co[0::2].copy(), co[1::2].copy()
+
+
+def current_slot_identifier(id_block):
+    """The identifier of the action slot id_block uses (None before 4.4 or when unset)."""
+    anim = id_block.animation_data
+    if not _SLOTTED or anim is None or anim.action_slot is None:
+        return None
+    return anim.action_slot.identifier
+
+
+def assign_action(id_block, action, slot_identifier=None):
+    """Make `action` animate id_block, on the slot with slot_identifier when given
+    (4.4+), else on its only slot, else a new one. action=None unassigns."""
+    anim = id_block.animation_data or id_block.animation_data_create()
+    anim.action = action
+    if action is None or not _SLOTTED:
+        return
+    slot = None
+    for candidate in action.slots:
+        if slot_identifier is not None and candidate.identifier == slot_identifier:
+            slot = candidate
+    if slot is None and slot_identifier is None and len(action.slots) == 1:
+        slot = action.slots[0]
+    if slot is None:
+        slot = action.slots.new(id_type=id_block.id_type, name=id_block.name)
+    anim.action_slot = slot
+
+
+_KEY_VECTORS = ("co", "handle_left", "handle_right")
+_KEY_ENUMS = ("interpolation", "handle_left_type", "handle_right_type", "easing")
+
+
+def copy_keys(fcurve):
+    """Everything of an F-curve's keys (positions, handles, interpolation, easing) and
+    its extrapolation, read in bulk, for copy_into."""
+    points = fcurve.keyframe_points
+    n = len(points)
+    data = {"data_path": fcurve.data_path, "index": fcurve.array_index,
+            "group": fcurve.group.name if fcurve.group else "", "extrapolation": fcurve.extrapolation}
+    for name in _KEY_VECTORS:
+        data[name] = np.empty(2 * n, dtype=np.float32)
+        points.foreach_get(name, data[name])
+    for name in _KEY_ENUMS:
+        data[name] = np.empty(n, dtype=np.int32)
+        points.foreach_get(name, data[name])
+    return data
+
+
+def copy_into(action, id_block, data):
+    """Recreate an F-curve saved by copy_keys in `action` (animating id_block)."""
+    fcurve = ensure_fcurve(action, id_block, data["data_path"], data["index"], data["group"])
+    points = fcurve.keyframe_points
+    points.add(len(data["interpolation"]))
+    for name in _KEY_VECTORS + _KEY_ENUMS:
+        points.foreach_set(name, data[name])
+    fcurve.extrapolation = data["extrapolation"]
+    fcurve.update()
+    return fcurve

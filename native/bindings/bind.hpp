@@ -4,8 +4,8 @@
 #include <pybind11/pybind11.h>
 
 namespace kodawari::bind {
-// void bind_<area>(pybind11::module_& m);  declared here as each area lands
 void bind_swim(pybind11::module_& m);
 void bind_ffd(pybind11::module_& m);
 void bind_rod(pybind11::module_& m);
+void bind_gait(pybind11::module_& m);
 }  // namespace kodawari::bind

@@ -1,0 +1,25 @@
+"""Quadruped gaits: walk, trot, canter and gallop from a speed curve, legs solved by
+CCD IK with joint limits and stiffness, baked to an Action (seed section 3)."""
+
+import bpy
+
+from . import ops, panel, props, runtime
+
+CLASSES = (
+    props.KodawariGaitBone,
+    props.KodawariGaitLeg,
+    props.KodawariGaitEntry,
+    props.KodawariGaitSettings,
+    ops.KODAWARI_OT_gait_setup,
+    ops.KODAWARI_OT_gait_bake,
+    ops.KODAWARI_OT_gait_report,
+    panel.KODAWARI_PT_gait,
+)
+
+PROPERTIES = (
+    (bpy.types.Object, "kodawari_gait", lambda: bpy.props.PointerProperty(type=props.KodawariGaitSettings)),
+)
+
+HANDLERS = (
+    ("load_post", runtime.on_load_post),
+)

@@ -1,0 +1,246 @@
+"""The gait bake as a job: validate and solve first (nothing touched), then write the
+Action in steps a modal operator can interleave with progress and Esc, or run at once.
+Cancel puts back exactly what was there."""
+
+import bpy
+import numpy as np
+
+from .. import fcurves, native
+from . import rig as rigmod
+from . import runtime
+from .props import GAIT_NAMES, LEG_NAMES
+
+CONTACT_PROPS = tuple(f"kodawari_contact_{leg}" for leg in LEG_NAMES)
+GAIT_PROP = "kodawari_gait_index"  # the gait in use per frame (0 WALK .. 4 GALLOP_ROTARY), for the report
+
+
+def _sample_channel(obj, data_path, frames, constant):
+    """Per-frame values of an animated setting (one evaluate per frame), else constant."""
+    anim = obj.animation_data
+    curve = None
+    if anim is not None and anim.action is not None:
+        curve = fcurves.find_fcurve(anim.action, obj, data_path)
+    if curve is None:
+        return np.full(len(frames), constant, dtype=np.float64)
+    return np.array([curve.evaluate(float(f)) for f in frames], dtype=np.float64)
+
+
+def _path_points(context, obj, path_obj):
+    depsgraph = context.evaluated_depsgraph_get()
+    evaluated = path_obj.evaluated_get(depsgraph)
+    mesh = evaluated.to_mesh()
+    try:
+        n = len(mesh.vertices)
+        co = np.empty(n * 3, dtype=np.float64)
+        mesh.vertices.foreach_get("co", co)
+    finally:
+        evaluated.to_mesh_clear()
+    if n < 2:
+        raise ValueError(f"the path curve '{path_obj.name}' has no length")
+    to_arm = obj.matrix_world.inverted() @ path_obj.matrix_world
+    rotation = rigmod.mat3(to_arm)
+    offset = np.array([float(to_arm[i][3]) for i in range(3)])
+    pts = co.reshape(-1, 3) @ rotation.T + offset
+    return np.ascontiguousarray(pts)
+
+
+def _heightfield(context, obj, ground, feet, margin=1.0, max_cells=256):
+    """Ground heights (armature space) on a grid over the run, by ray casts straight
+    down onto the ground mesh. Raises ValueError when rays miss."""
+    from mathutils import Vector
+    from mathutils.bvhtree import BVHTree
+
+    depsgraph = context.evaluated_depsgraph_get()
+    tree = BVHTree.FromObject(ground.evaluated_get(depsgraph), depsgraph)
+    lo = feet[:, :, :2].reshape(-1, 2).min(axis=0) - margin
+    hi = feet[:, :, :2].reshape(-1, 2).max(axis=0) + margin
+    cell = max(float((hi - lo).max()) / (max_cells - 1), 0.05)
+    nx = int(np.ceil((hi[0] - lo[0]) / cell)) + 1
+    ny = int(np.ceil((hi[1] - lo[1]) / cell)) + 1
+    arm_to_ground = ground.matrix_world.inverted() @ obj.matrix_world
+    ground_to_arm = obj.matrix_world.inverted() @ ground.matrix_world
+    top = float(feet[:, :, 2].max()) + 1000.0
+    direction = (arm_to_ground.to_3x3() @ Vector((0.0, 0.0, -1.0))).normalized()
+    heights = np.empty(nx * ny, dtype=np.float64)
+    misses = 0
+    # One ray per grid cell (not per frame): a set-up cost, like reading the rig.
+    for j in range(ny):
+        y = lo[1] + j * cell
+        for i in range(nx):
+            origin = arm_to_ground @ Vector((lo[0] + i * cell, y, top))
+            hit = tree.ray_cast(origin, direction)
+            if hit[0] is None:
+                heights[j * nx + i] = np.nan
+                misses += 1
+            else:
+                heights[j * nx + i] = (ground_to_arm @ hit[0]).z
+    if misses:
+        raise ValueError(f"the ground '{ground.name}' does not lie under the whole run "
+                         f"({misses} of {nx * ny} rays missed): move or enlarge it, or clear Ground")
+    return {"x0": float(lo[0]), "y0": float(lo[1]), "cell": cell, "nx": nx, "ny": ny, "heights": heights}
+
+
+class GaitBakeJob:
+    """validate+solve in __init__ (raises ValueError), then begin/steps/finish or cancel."""
+
+    def __init__(self, context, obj, frame_start, frame_end):
+        if obj is None or obj.type != "ARMATURE":
+            raise ValueError("the active object is not an armature")
+        if frame_end <= frame_start:
+            raise ValueError("frame_end must be after frame_start")
+        kn = native.module()
+        settings = obj.kodawari_gait
+        self.obj = obj
+        self.scene = context.scene
+        self.frames = np.arange(frame_start, frame_end + 1, dtype=np.float64)
+        self.fps = self.scene.render.fps / self.scene.render.fps_base
+        self.rig, self.chains = rigmod.rig_dict(obj, settings)
+        self.table = rigmod.table_dict(settings)
+        why = kn.gait_validate_table(self.table)
+        if why:
+            raise ValueError(why)
+        speed = _sample_channel(obj, "kodawari_gait.speed", self.frames, settings.speed)
+        gait_index = GAIT_NAMES.index(settings.gait) if settings.gait != "AUTO" else -1
+        mode = _sample_channel(obj, "kodawari_gait.gait", self.frames, gait_index + 1) - 1
+        mode = np.clip(np.round(mode), -1, 4)
+        if (speed < 0).any():
+            f = int(self.frames[np.argmax(speed < 0)])
+            raise ValueError(f"speed is negative ({speed[speed < 0][0]:.2f} m/s at frame {f}): "
+                             "key speeds of 0 or more")
+        length = rigmod.leg_length(self.rig)
+        tops = {int(g): kn.gait_table_speed_max(self.table, int(g), length) for g in np.unique(mode)}
+        top = np.array([tops[int(g)] for g in mode]) if len(tops) > 1 else np.full(len(mode), tops[int(mode[0])])
+        too_fast = speed > top + 1e-6
+        if too_fast.any():
+            f = int(np.argmax(too_fast))
+            g = int(mode[f])
+            what = "the gait table" if g < 0 else GAIT_NAMES[g]
+            raise ValueError(f"speed {speed[f]:.2f} m/s at frame {int(self.frames[f])} is past the range of {what} "
+                             f"(top {top[f]:.2f} m/s): lower it or raise the table's top speed")
+        path = _path_points(context, obj, settings.path) if settings.path is not None else None
+        args = (self.rig, self.table, np.ascontiguousarray(speed), np.ascontiguousarray(mode, dtype=np.float64),
+                float(self.fps), float(settings.acceleration), int(settings.ccd_iterations))
+        result = kn.gait_bake(*args, path=path)
+        if settings.ground is not None:
+            ground = _heightfield(context, obj, settings.ground, result["feet_planned"])
+            result = kn.gait_bake(*args, path=path, ground=ground)
+            planted = result["contacts"] > 0.5
+            miss = np.where(planted, result["ik_error"], 0.0)
+            if miss.max() > 0.02:
+                f = int(self.frames[np.argmax(miss.max(axis=1))])
+                raise ValueError(f"the ground '{settings.ground.name}' is out of the legs' reach (a planted foot "
+                                 f"misses it by {miss.max():.2f} m at frame {f})")
+        self.result = result
+        self.axes = rigmod.hinge_axes(obj, self.chains, self.rig["forward"])
+        self._started = False
+
+    # --- writing -------------------------------------------------------------------
+    def begin(self):
+        obj = self.obj
+        anim = obj.animation_data
+        self._old_action = anim.action if anim is not None else None
+        self._old_slot = fcurves.current_slot_identifier(obj)
+        self._old_modes = {pb.name: pb.rotation_mode for pb in obj.pose.bones}
+        self._old_props = {k: obj[k] for k in CONTACT_PROPS + (GAIT_PROP,) if k in obj.keys()}
+        # A new Action (the old one stays untouched until finish, so Esc can put it
+        # back); the curves this bake does not own (the speed keys, other bones) are
+        # copied over, the gait channels are written fresh.
+        owned = self._owned_paths()
+        kept = []
+        if self._old_action is not None:
+            kept = [fcurves.copy_keys(c) for c in fcurves.action_fcurves(self._old_action, obj)
+                    if c.data_path not in owned]
+        action = bpy.data.actions.new(self._old_action.name if self._old_action else f"{obj.name}Gait")
+        self.action = action
+        fcurves.assign_action(obj, action, None)
+        for data in kept:
+            fcurves.copy_into(action, obj, data)
+        self._started = True
+
+    def _owned_paths(self):
+        bones = [n for leg in LEG_NAMES for n in self.chains[leg]]
+        body = self.obj.kodawari_gait.body_bone
+        paths = {f'pose.bones["{n}"].rotation_quaternion' for n in bones + [body]}
+        paths.update(f'pose.bones["{n}"].rotation_euler' for n in bones)
+        paths.add(f'pose.bones["{body}"].location')
+        paths.update(f'["{p}"]' for p in CONTACT_PROPS + (GAIT_PROP,))
+        return paths
+
+    def steps(self):
+        """Write one channel group per step; yields the fraction done."""
+        obj, action, frames, r = self.obj, self.action, self.frames, self.result
+        settings = obj.kodawari_gait
+        jobs = []
+        column = 0
+        for leg in LEG_NAMES:
+            for name in self.chains[leg]:
+                jobs.append(("bone", name, column))
+                column += 1
+        jobs += [("body", settings.body_bone, None), ("contacts", None, None)]
+        for i, (kind, name, col) in enumerate(jobs):
+            if kind == "bone":
+                axis = self.axes[name]
+                mode, sign = rigmod.hinge_channel(axis)
+                if mode == "X":
+                    # A hinge about the bone's own X axis: one Euler channel says it all.
+                    obj.pose.bones[name].rotation_mode = "XYZ"
+                    euler = np.zeros((len(frames), 3))
+                    euler[:, 0] = sign * r["angles"][:, col]
+                    fcurves.write_channels(action, obj, f'pose.bones["{name}"].rotation_euler', frames,
+                                           euler[:, :1], group=name)
+                else:
+                    obj.pose.bones[name].rotation_mode = "QUATERNION"
+                    half = r["angles"][:, col] / 2
+                    quat = np.stack([np.cos(half), axis[0] * np.sin(half), axis[1] * np.sin(half),
+                                     axis[2] * np.sin(half)], axis=1)
+                    fcurves.write_channels(action, obj, f'pose.bones["{name}"].rotation_quaternion', frames,
+                                           quat, group=name)
+            elif kind == "body":
+                obj.pose.bones[name].rotation_mode = "QUATERNION"
+                fcurves.write_channels(action, obj, f'pose.bones["{name}"].location', frames,
+                                       r["body_location"], group=name)
+                fcurves.write_channels(action, obj, f'pose.bones["{name}"].rotation_quaternion', frames,
+                                       r["body_rotation"], group=name)
+            else:
+                for k, prop in enumerate(CONTACT_PROPS):
+                    obj[prop] = float(r["contacts"][0, k])
+                    fcurves.write_channels(action, obj, f'["{prop}"]', frames, r["contacts"][:, k],
+                                           group="Kodawari Gait", interpolation="CONSTANT")
+                obj[GAIT_PROP] = float(r["gait"][0])
+                fcurves.write_channels(action, obj, f'["{GAIT_PROP}"]', frames, r["gait"].astype(np.float64),
+                                       group="Kodawari Gait", interpolation="CONSTANT")
+            yield (i + 1) / len(jobs)
+
+    def finish(self):
+        old = self._old_action
+        if old is not None and old.users == 0 and not old.use_fake_user:
+            name = old.name
+            bpy.data.actions.remove(old)
+            self.action.name = name
+        runtime.remember(self.obj, self)
+        self.obj.update_tag()
+
+    def cancel(self):
+        """Put back the action, slot, rotation modes and custom properties."""
+        if not self._started:
+            return
+        obj = self.obj
+        fcurves.assign_action(obj, self._old_action, self._old_slot)
+        if self._old_action is None and obj.animation_data is not None:
+            obj.animation_data.action = None
+        bpy.data.actions.remove(self.action)
+        for name, mode in self._old_modes.items():
+            if name in obj.pose.bones:
+                obj.pose.bones[name].rotation_mode = mode
+        for key in CONTACT_PROPS + (GAIT_PROP,):
+            if key in self._old_props:
+                obj[key] = self._old_props[key]
+            elif key in obj.keys():
+                del obj[key]
+        self._started = False
+
+    def run(self):
+        self.begin()
+        for _ in self.steps():
+            pass
+        self.finish()

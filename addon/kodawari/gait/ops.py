@@ -1,0 +1,170 @@
+"""Operators: gait_setup (find the legs), gait_bake (plan + solve + write an Action),
+gait_report (measure the baked Action, write PNG + JSON)."""
+
+import bpy
+import numpy as np
+
+from .. import native
+from . import rig as rigmod
+from .bake import GaitBakeJob
+from .props import LEG_NAMES
+from .report import write_report
+
+
+def _armature(context):
+    obj = context.active_object
+    return obj if obj is not None and obj.type == "ARMATURE" else None
+
+
+class KODAWARI_OT_gait_setup(bpy.types.Operator):
+    """Find the four legs (by name, or from four selected foot bones) and the body bone,
+    and fill the gait settings with horse defaults"""
+
+    bl_idname = "kodawari.gait_setup"
+    bl_label = "Gait Setup"
+    bl_options = {"REGISTER", "UNDO"}
+
+    def execute(self, context):
+        obj = _armature(context)
+        if obj is None:
+            self.report({"ERROR"}, "Gait Setup needs an armature as the active object")
+            return {"CANCELLED"}
+        armature = obj.data
+        selected = [pb.name for pb in (context.selected_pose_bones or [])] if context.mode == "POSE" else []
+        if len(selected) == 4:
+            legs, how = rigmod.find_legs_from_feet(armature, selected), "from the four selected feet"
+        else:
+            legs, how = rigmod.find_legs_by_name(armature), "by name"
+        missing = [k for k in LEG_NAMES if k not in legs]
+        if missing:
+            found = ", ".join(f"{k} ({len(v)} bones)" for k, v in legs.items()) or "none"
+            self.report({"ERROR"}, f"Found fewer than four legs {how}: found {found}; missing {', '.join(missing)}. "
+                        "Name leg bones with a side (.L/.R, _L/_R, Left/Right) and an end (fore/front/arm, "
+                        "hind/back/rear), or select the four foot bones in Pose Mode")
+            return {"CANCELLED"}
+        short = [k for k in LEG_NAMES if len(legs[k]) < 2]
+        if short:
+            self.report({"ERROR"}, f"Leg {', '.join(short)} has a single bone; a leg needs 2 to 6 bones")
+            return {"CANCELLED"}
+        body = rigmod.find_body(armature, legs)
+        if body is None:
+            self.report({"ERROR"}, "No body bone: the four legs need a common parent bone to carry root motion")
+            return {"CANCELLED"}
+        # Validate the geometry before touching the settings.
+        probe = {"forward": rigmod.forward_of(armature, legs), "body_head": np.zeros(3), "body_rest": np.eye(3),
+                 "legs": []}
+        for k in LEG_NAMES:
+            bones = [armature.bones[n] for n in legs[k]]
+            probe["legs"].append({"heads": np.array([b.head_local for b in bones], dtype=np.float64),
+                                  "tail": np.array(bones[-1].tail_local, dtype=np.float64),
+                                  "limit_min": np.full(len(bones), -1.0), "limit_max": np.full(len(bones), 1.0),
+                                  "stiffness": np.ones(len(bones))})
+        why = native.module().gait_validate_rig(probe)
+        if why:
+            self.report({"ERROR"}, f"The legs cannot be solved: {why}")
+            return {"CANCELLED"}
+        rigmod.fill_horse_defaults(obj.kodawari_gait, armature, legs, body)
+        summary = "; ".join(f"{k}: {' > '.join(legs[k])}" for k in LEG_NAMES)
+        self.report({"INFO"}, f"Found 4 legs {how} and body bone '{body}'. {summary}")
+        return {"FINISHED"}
+
+
+class KODAWARI_OT_gait_bake(bpy.types.Operator):
+    """Plan the gait from the speed curve, solve every leg, and bake it to an Action"""
+
+    bl_idname = "kodawari.gait_bake"
+    bl_label = "Bake Gait"
+    bl_options = {"REGISTER", "UNDO"}
+
+    frame_start: bpy.props.IntProperty(name="Start", default=1)
+    frame_end: bpy.props.IntProperty(name="End", default=250)
+
+    def _make_job(self, context):
+        try:
+            return GaitBakeJob(context, _armature(context) or context.active_object, self.frame_start,
+                               self.frame_end)
+        except ValueError as exc:
+            self.report({"ERROR"}, f"Gait bake: {exc}")
+            return None
+
+    def execute(self, context):
+        job = self._make_job(context)
+        if job is None:
+            return {"CANCELLED"}
+        job.run()
+        self.report({"INFO"}, f"Baked {len(job.frames)} frames of gait on '{job.obj.name}'")
+        return {"FINISHED"}
+
+    def invoke(self, context, event):
+        if not self.properties.is_property_set("frame_start"):
+            self.frame_start = context.scene.frame_start
+        if not self.properties.is_property_set("frame_end"):
+            self.frame_end = context.scene.frame_end
+        if bpy.app.background:
+            return self.execute(context)
+        self._job = self._make_job(context)
+        if self._job is None:
+            return {"CANCELLED"}
+        self._job.begin()
+        self._steps = self._job.steps()
+        wm = context.window_manager
+        wm.progress_begin(0, 100)
+        self._timer = wm.event_timer_add(0.01, window=context.window)
+        wm.modal_handler_add(self)
+        return {"RUNNING_MODAL"}
+
+    def modal(self, context, event):
+        wm = context.window_manager
+        if event.type == "ESC":
+            self._job.cancel()
+            self._end(context)
+            self.report({"WARNING"}, "Gait bake cancelled: nothing changed")
+            return {"CANCELLED"}
+        if event.type != "TIMER":
+            return {"PASS_THROUGH"}
+        try:
+            fraction = next(self._steps)
+            wm.progress_update(int(fraction * 100))
+        except StopIteration:
+            self._job.finish()
+            self._end(context)
+            self.report({"INFO"}, f"Baked {len(self._job.frames)} frames of gait on '{self._job.obj.name}'")
+            return {"FINISHED"}
+        return {"RUNNING_MODAL"}
+
+    def _end(self, context):
+        wm = context.window_manager
+        wm.event_timer_remove(self._timer)
+        wm.progress_end()
+
+
+class KODAWARI_OT_gait_report(bpy.types.Operator):
+    """Measure the baked gait: footfall diagram and fore-aft foot trajectories (PNG) and
+    the seed's smoothness criteria per gait segment (JSON)"""
+
+    bl_idname = "kodawari.gait_report"
+    bl_label = "Gait Report"
+    bl_options = {"REGISTER", "UNDO"}
+
+    filepath: bpy.props.StringProperty(name="File Path", subtype="FILE_PATH", default="//gait_report.png")
+
+    def execute(self, context):
+        obj = _armature(context)
+        if obj is None:
+            self.report({"ERROR"}, "Gait Report needs an armature as the active object")
+            return {"CANCELLED"}
+        if not self.filepath:
+            self.report({"ERROR"}, "Gait Report needs a file path")
+            return {"CANCELLED"}
+        scene = context.scene
+        try:
+            png, js, _ = write_report(obj, self.filepath, scene.render.fps / scene.render.fps_base)
+        except (ValueError, OSError) as exc:
+            self.report({"ERROR"}, f"Gait report: {exc}")
+            return {"CANCELLED"}
+        self.report({"INFO"}, f"Wrote {png} and {js}")
+        return {"FINISHED"}
+
+    def invoke(self, context, event):
+        context.window_manager.fileselect_add(self)
+        return {"RUNNING_MODAL"}

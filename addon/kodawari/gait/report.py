@@ -1,0 +1,205 @@
+"""gait_report: measure the baked Action (not the solver's memory) and write the
+seed's smoothness criteria as JSON plus a footfall (Hildebrand) diagram and fore-aft
+foot trajectories (seed figures 4.7, 4.8) as one PNG, drawn with NumPy."""
+
+import json
+import os
+
+import bpy
+import numpy as np
+
+from .. import fcurves, native
+from . import metrics
+from . import rig as rigmod
+from .bake import CONTACT_PROPS, GAIT_PROP
+from .font import draw_text
+from .props import LEG_NAMES
+
+GAIT_COLORS = {  # soft backgrounds per gait segment
+    0: (0.86, 0.93, 0.86, 1), 1: (0.86, 0.90, 0.98, 1), 2: (0.98, 0.93, 0.84, 1),
+    3: (0.98, 0.86, 0.86, 1), 4: (0.93, 0.86, 0.98, 1)}
+LEG_COLORS = ((0.85, 0.2, 0.1, 1), (0.95, 0.6, 0.1, 1), (0.1, 0.35, 0.85, 1), (0.1, 0.65, 0.6, 1))
+
+
+def _curve(action, obj, path, index=0):
+    c = fcurves.find_fcurve(action, obj, path, index)
+    if c is None or len(c.keyframe_points) == 0:
+        return None
+    return fcurves.read_keys(c)
+
+
+def read_baked(obj):
+    """The baked channels as arrays; raises ValueError when there is no gait bake."""
+    anim = obj.animation_data
+    action = anim.action if anim is not None else None
+    if action is None:
+        raise ValueError(f"'{obj.name}' has no Action: bake the gait first")
+    settings = obj.kodawari_gait
+    rig, chains = rigmod.rig_dict(obj, settings)
+    contacts = [_curve(action, obj, f'["{p}"]') for p in CONTACT_PROPS]
+    gait = _curve(action, obj, f'["{GAIT_PROP}"]')
+    if any(c is None for c in contacts) or gait is None:
+        raise ValueError(f"'{obj.name}' has no gait bake (no kodawari_contact_* channels): bake the gait first")
+    frames = gait[0]
+    n = len(frames)
+    axes = rigmod.hinge_axes(obj, chains, rig["forward"])
+    angles = []
+    for leg in LEG_NAMES:
+        for name in chains[leg]:
+            mode, sign = rigmod.hinge_channel(axes[name])
+            if mode == "X":
+                keys = _curve(action, obj, f'pose.bones["{name}"].rotation_euler', 0)
+                if keys is None or len(keys[0]) != n:
+                    raise ValueError(f"bone '{name}' has no baked rotation: bake the gait again")
+                angles.append(sign * keys[1].astype(np.float64))
+                continue
+            q = []
+            for i in range(4):
+                keys = _curve(action, obj, f'pose.bones["{name}"].rotation_quaternion', i)
+                if keys is None or len(keys[0]) != n:
+                    raise ValueError(f"bone '{name}' has no baked rotation: bake the gait again")
+                q.append(keys[1].astype(np.float64))
+            q = np.stack(q, axis=1)
+            # Hinge angle back from the quaternion (w, axis * sin(a/2)).
+            angles.append(2 * np.arctan2(q[:, 1:] @ axes[name], q[:, 0]))
+    body = settings.body_bone
+    loc = np.stack([_curve(action, obj, f'pose.bones["{body}"].location', i)[1] for i in range(3)], axis=1)
+    rot = np.stack([_curve(action, obj, f'pose.bones["{body}"].rotation_quaternion', i)[1] for i in range(4)],
+                   axis=1)
+    return {"rig": rig, "chains": chains, "frames": frames, "angles": np.ascontiguousarray(np.stack(angles, axis=1)),
+            "body_location": np.ascontiguousarray(loc, dtype=np.float64),
+            "body_rotation": np.ascontiguousarray(rot, dtype=np.float64),
+            "contacts": np.stack([c[1] for c in contacts], axis=1).astype(np.float64),
+            "gait": np.round(gait[1]).astype(int)}
+
+
+def headings_of(rig, body_rotation):
+    """Unit forward of the body per frame, from the baked body rotation."""
+    rest = rig["body_rest"]
+    q = body_rotation / np.linalg.norm(body_rotation, axis=1, keepdims=True)
+    w, x, y, z = q.T
+    m = np.stack([
+        np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)], axis=1),
+        np.stack([2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)], axis=1),
+        np.stack([2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)], axis=1)], axis=1)
+    world = np.einsum("ij,fjk,kl->fil", rest, m, rest.T)
+    h = world @ rig["forward"]
+    h[:, 2] = 0
+    return h / np.linalg.norm(h, axis=1, keepdims=True)
+
+
+def measure_baked(obj, fps):
+    data = read_baked(obj)
+    kn = native.module()
+    feet, roots = kn.gait_forward_kinematics(data["rig"], data["angles"], data["body_location"],
+                                             data["body_rotation"])
+    rig = data["rig"]
+    limit_min = np.concatenate([leg["limit_min"] for leg in rig["legs"]])
+    limit_max = np.concatenate([leg["limit_max"] for leg in rig["legs"]])
+    reach = np.array([rig_reach(rig, k) for k in range(4)])
+    headings = headings_of(rig, data["body_rotation"])
+    segs = metrics.measure(feet, roots, headings, data["contacts"], data["gait"], data["angles"], limit_min,
+                           limit_max, rigmod.neutral_offsets(rig), reach, fps)
+    data.update(feet=feet, roots=roots, headings=headings, segments=segs, reach=reach)
+    return data
+
+
+def rig_reach(rig, leg):
+    legrig = rig["legs"][leg]
+    points = np.vstack([legrig["heads"], legrig["tail"][None, :]])
+    planar = np.diff(points, axis=0)
+    f = planar @ rig["forward"]
+    length = float(np.sum(np.hypot(f, planar[:, 2])))
+    return length * rig.get("reach_fraction", 0.5)
+
+
+# --- drawing ------------------------------------------------------------------------
+def _line(img, x0, y0, x1, y1, color, width=1):
+    n = int(max(abs(x1 - x0), abs(y1 - y0))) + 1
+    xs = np.linspace(x0, x1, n).round().astype(int)
+    ys = np.linspace(y0, y1, n).round().astype(int)
+    h, w = img.shape[:2]
+    for d in range(-(width // 2), width - width // 2):
+        ok = (xs >= 0) & (xs < w) & (ys + d >= 0) & (ys + d < h)
+        img[ys[ok] + d, xs[ok]] = color
+
+
+def draw_report(data, fps, width=1400):
+    feet, roots, headings = data["feet"], data["roots"], data["headings"]
+    contacts, gait, reach = data["contacts"], data["gait"], data["reach"]
+    n = len(gait)
+    offsets = metrics.fore_aft(feet, roots, headings, rigmod.neutral_offsets(data["rig"]))
+    left, right = 70, 20
+    plot_w = width - left - right
+    row_h, top = 26, 40
+    foot_h = 4 * row_h
+    traj_top = top + foot_h + 60
+    traj_h = 300
+    height = traj_top + traj_h + 50
+    img = np.ones((height, width, 4), dtype=np.float32)
+    black = (0.1, 0.1, 0.1, 1)
+    xs = left + np.arange(n) * plot_w / max(n - 1, 1)
+    # gait segments behind both plots, with their names
+    for g, lo, hi in metrics.segments(gait):
+        x0, x1 = int(xs[lo]), int(xs[hi - 1]) + 1
+        img[top:top + foot_h, x0:x1] = GAIT_COLORS[g]
+        img[traj_top:traj_top + traj_h, x0:x1] = GAIT_COLORS[g]
+        if x1 - x0 > 40:
+            draw_text(img, x0 + 3, top - 14, metrics.GAITS[g].replace("GALLOP_ROTARY", "ROTARY"), black, 1)
+    draw_text(img, left, 8, "FOOTFALLS (HILDEBRAND): BLACK = PLANTED", black, 2)
+    for row, leg in enumerate((2, 0, 1, 3)):  # LH, LF, RF, RH
+        y = top + row * row_h
+        draw_text(img, 10, y + 6, metrics.LEGS[leg], black, 2)
+        planted = contacts[:, leg] > 0.5
+        for f in np.flatnonzero(planted):
+            img[y + 4:y + row_h - 4, int(xs[f]):int(xs[min(f + 1, n - 1)]) + 1] = black
+    # fore-aft trajectories relative to each leg's root (seed figures 4.7, 4.8)
+    lim = float(max(reach.max(), np.abs(offsets).max())) * 1.1
+    def ypix(v):
+        return traj_top + traj_h / 2 - v / lim * (traj_h / 2)
+    draw_text(img, left, traj_top - 34, "FORE-AFT FOOT POSITION FROM LEG ROOT (M), +- REACH", black, 2)
+    _line(img, left, ypix(0), left + plot_w, ypix(0), (0.5, 0.5, 0.5, 1))
+    for leg in range(4):
+        for sign in (1, -1):
+            yl = ypix(sign * reach[leg])
+            for x in range(left, left + plot_w, 12):
+                _line(img, x, yl, min(x + 6, left + plot_w), yl, LEG_COLORS[leg])
+    for leg in range(4):
+        for f in range(n - 1):
+            _line(img, xs[f], ypix(offsets[f, leg]), xs[f + 1], ypix(offsets[f + 1, leg]), LEG_COLORS[leg], 2)
+        draw_text(img, left + 10 + leg * 60, traj_top + traj_h + 10, metrics.LEGS[leg], LEG_COLORS[leg], 2)
+    for v in (-lim / 1.1, 0.0, lim / 1.1):
+        draw_text(img, 4, int(ypix(v)) - 4, f"{v:+.1f}", black, 1)
+    seconds = n / fps
+    draw_text(img, left + plot_w - 160, traj_top + traj_h + 10, f"{seconds:.1f} S", black, 2)
+    return img
+
+
+def save_png(pixels, filepath):
+    """(H, W, 4) float image, row 0 at the top, saved through bpy.data.images."""
+    h, w = pixels.shape[:2]
+    image = bpy.data.images.new("kodawari_gait_report", width=w, height=h, alpha=True)
+    try:
+        image.pixels.foreach_set(np.ascontiguousarray(pixels[::-1]).reshape(-1))
+        image.filepath_raw = filepath
+        image.file_format = "PNG"
+        image.save()
+    finally:
+        bpy.data.images.remove(image)
+
+
+def write_report(obj, filepath, fps):
+    base, ext = os.path.splitext(bpy.path.abspath(filepath))
+    if ext.lower() not in (".png", ".json"):
+        base = base + ext
+    data = measure_baked(obj, fps)
+    directory = os.path.dirname(base)
+    if directory:
+        os.makedirs(directory, exist_ok=True)
+    report = {"object": obj.name, "fps": fps, "frame_start": float(data["frames"][0]),
+              "frame_end": float(data["frames"][-1]), "reach": [float(r) for r in data["reach"]],
+              "segments": data["segments"]}
+    with open(base + ".json", "w") as fh:
+        json.dump(report, fh, indent=1)
+    save_png(draw_report(data, fps), base + ".png")
+    return base + ".png", base + ".json", data
