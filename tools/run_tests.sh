@@ -3,6 +3,7 @@
 #   native   C++ GoogleTest through ctest
 #   python   pytest against kodawari_native, no Blender
 #   blender-3.4  the real program: blender -b ... --python tests/blender/run_pytest.py
+#   ui-3.4       the real program in a window on a virtual screen (modal bakes, Esc)
 #   bpy-4.5, bpy-5.0  the same test files under Blender as a Python module
 set -uo pipefail
 cd "$(dirname "$0")/.."
@@ -36,6 +37,10 @@ pip_install_tier() {  # `pip install .` (scikit-build-core, same CMake) into a s
 tier pip-install pip_install_tier
 tier blender-3.4 env $(blender_env) "$BLENDER" "${BLENDER_ARGS[@]}" \
   --python tests/blender/run_pytest.py -- -q tests/blender --junitxml="$REPORTS/blender-3.4.xml"
+# Modal bakes and Esc need Blender's real window: a virtual screen, simulated key presses.
+tier ui-3.4 env $(blender_env) KODAWARI_UI_REPORT="$REPORTS/ui-3.4.xml" timeout 600 xvfb-run -a -s "-screen 0 640x480x24" \
+  "$BLENDER" --factory-startup -noaudio --python-exit-code 1 --enable-event-simulate \
+  --python tools/blender_install_addon.py --python tests/ui/run_ui_tests.py
 tier bpy-4.5 env $(blender_env) "$VENV/bin/python" -m pytest -q -p no:cacheprovider tests/blender \
   --junitxml="$REPORTS/bpy-4.5.xml"
 if [ -x "$VENV5/bin/python" ]; then

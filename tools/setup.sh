@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Installs what Kodawari needs and skips what is present.
 #   Debian packages: Blender 3.4 (the real program), Eigen, GLM, GoogleTest,
-#                    Google Benchmark, the system Python's pytest (Blender 3.4 runs it).
+#                    Google Benchmark, the system Python's pytest (Blender 3.4 runs it),
+#                    Xvfb and Mesa (Blender's real window for the UI tests).
 #   PyPI, into the project virtual environment $VENV: tools/requirements.txt
 #   (bpy 4.5, pybind11, scikit-build-core, numpy, pytest, matplotlib, cmake, ninja),
 #   and, when it installs for this Python, bpy 5.0 into $VENV5.
@@ -19,7 +20,8 @@ die() { printf '[setup] ERROR: %s\n' "$*" >&2; exit 1; }
 
 # --- Debian packages ---------------------------------------------------------
 DEBS=(blender libeigen3-dev libglm-dev libgtest-dev libgmock-dev libbenchmark-dev
-      python3-pytest python3-numpy g++ make)
+      python3-pytest python3-numpy g++ make
+      xvfb xauth libgl1-mesa-dri)  # a virtual screen for the tests that need Blender's window
 missing=()
 for pkg in "${DEBS[@]}"; do
   dpkg-query -W -f='${Status}' "$pkg" 2>/dev/null | grep -q "install ok installed" || missing+=("$pkg")
