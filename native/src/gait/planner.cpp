@@ -19,6 +19,10 @@ constexpr Real kReachMargin = 0.93;  // IK targets stay inside 93% of what the c
 constexpr int kReachSamples = 64;
 constexpr Real kIkTolerance = 2e-4;  // m: a planted foot is solved to a fifth of a millimetre
 constexpr int kMaxBones = 6;
+// A swing the leg cannot follow within this (m) is re-planned lower (see the IK pass).
+constexpr Real kSwingTolerance = 0.01;
+// Shares of the gait's swing lift tried, in order, for a swing the leg cannot follow.
+constexpr Real kLiftScales[] = {1.0, 0.75, 0.5, 0.25, 0.0};
 
 Vec3 up() { return Vec3(0, 0, 1); }
 Vec2d horizontal(const Vec3& v) { return Vec2d(v.x(), v.y()); }
@@ -248,13 +252,18 @@ BakeOutput bake_gait(const BakeInput& in) {
     p.swing_peak = g.swing_peak;
     p.ease = swing_ease(std::max(speed[clamp_step(k)], v_td), g.swing_time);
   };
+  auto lift_at = [&](int leg, long k) -> Real {  // height of a swinging foot above its ground path
+    const LegPlan& p = plan[leg];
+    if (p.stance) return 0;
+    return p.swing_height * swing_lift(static_cast<Real>(k - p.swing_start) / p.swing_length, p.swing_peak);
+  };
   auto foot_at = [&](int leg, long k) -> Vec3 {
     const LegPlan& p = plan[leg];
     if (p.stance) return p.foot;
     const Real s = static_cast<Real>(k - p.swing_start) / p.swing_length;
     const Real w = swing_progress(s, p.ease);
     Vec3 x = p.foot + (p.target - p.foot) * w;
-    x.z() += p.swing_height * swing_lift(s, p.swing_peak);
+    x.z() += lift_at(leg, k);
     return x;
   };
 
@@ -281,6 +290,7 @@ BakeOutput bake_gait(const BakeInput& in) {
   const int order[kLegCount] = {kLH, kRH, kLF, kRF};  // LH first: the others follow its clock
   std::vector<Vec3> planned(static_cast<std::size_t>(frames) * kLegCount);
   std::vector<Real> contact(static_cast<std::size_t>(frames) * kLegCount);
+  std::vector<Real> lift(static_cast<std::size_t>(frames) * kLegCount);
   for (long k = 0; k <= last_step; ++k) {
     const bool gait_changed = k > 0 && gait[k] != gait[k - 1];
     for (int leg : order) {
@@ -305,6 +315,7 @@ BakeOutput bake_gait(const BakeInput& in) {
       for (int leg = 0; leg < kLegCount; ++leg) {
         planned[f * kLegCount + leg] = foot_at(leg, k);
         contact[f * kLegCount + leg] = plan[leg].stance ? 1 : 0;
+        lift[f * kLegCount + leg] = lift_at(leg, k);
       }
     }
   }
@@ -429,49 +440,151 @@ BakeOutput bake_gait(const BakeInput& in) {
   }
   // IK: each leg runs through the frames in order (warm start), legs in parallel; one
   // thread per leg does the same arithmetic whatever the thread count: deterministic.
+  struct LegIkState {
+    Real angles[kMaxBones] = {};
+    Real previous[kMaxBones] = {};  // the pose one frame before `angles`
+    Vec2d last_target = Vec2d(std::numeric_limits<Real>::quiet_NaN(), 0);
+    Real last_error = 0;
+  };
+  struct SwingTrack {  // one way of solving a swing: a pose and a miss per frame
+    std::vector<Real> angles, error;
+    Real worst = std::numeric_limits<Real>::infinity();
+  };
   parallel_for(kLegCount, 0, 1, [&](std::size_t begin, std::size_t end) {
     for (std::size_t l = begin; l < end; ++l) {
       const int leg = static_cast<int>(l);
-      Real* angles = pose.data() + bone_offset[leg];
-      const int n = chains[leg].size();
-      Real previous[kMaxBones] = {};
-      Vec2d last_target(std::numeric_limits<Real>::quiet_NaN(), 0);
-      Real last_error = 0;
-      for (int f = 0; f < frames; ++f) {
-        const Vec3& goal = planned[f * kLegCount + leg];
-        const Vec3 rest_goal = rotations[f].transpose() * (goal - heads[f]) + rig.body_head;
-        const Vec2d goal2(rest_goal.dot(F), rest_goal.z());
-        if (goal2 == last_target) {  // nothing moved (standing): keep the pose exactly
-          for (int c = 0; c < 3; ++c) out.feet_planned[(f * kLegCount + leg) * 3 + c] = goal[c];
-          out.ik_error[f * 4 + leg] = last_error;
-          for (int bone = 0; bone < n; ++bone) {
-            previous[bone] = angles[bone];
-            out.angles[static_cast<std::size_t>(f) * out.bones + bone_offset[leg] + bone] = angles[bone];
-          }
+      const LegChain& chain = chains[leg];
+      const int n = chain.size();
+      auto local_goal = [&](int f, const Vec3& goal) {
+        const Vec3 local = rotations[f].transpose() * (goal - heads[f]) + rig.body_head;  // rest space
+        return Vec2d(local.dot(F), local.z());
+      };
+      auto record = [&](int f, const Vec3& goal, const Real* angles, Real error) {
+        for (int c = 0; c < 3; ++c) out.feet_planned[(f * kLegCount + leg) * 3 + c] = goal[c];
+        out.ik_error[f * 4 + leg] = error;
+        std::copy(angles, angles + n, out.angles.begin() + static_cast<std::ptrdiff_t>(f) * out.bones + bone_offset[leg]);
+      };
+      // One frame on from `st` for the foot at `goal2`; returns the miss. The warm start
+      // is the previous frame's pose (seed 3.2) carried on by its change from the frame
+      // before (a foot's angles move smoothly, so this lands close), or `seed` if given.
+      auto advance = [&](LegIkState& st, const Vec2d& goal2, bool planted, bool first_frames, const Real* seed) {
+        Real* angles = st.angles;
+        if (goal2 == st.last_target) {  // nothing moved (standing): keep the pose exactly
+          std::copy(angles, angles + n, st.previous);
+          return st.last_error;
+        }
+        st.last_target = goal2;
+        for (int bone = 0; bone < n; ++bone) {
+          const Real last = angles[bone];
+          angles[bone] = seed ? seed[bone] : first_frames ? last : last + (last - st.previous[bone]);
+          st.previous[bone] = last;
+        }
+        st.last_error = solve_ccd(chain, goal2, in.ccd_iterations, kIkTolerance, angles, planted).error;
+        return st.last_error;
+      };
+      LegIkState state;
+      std::copy(pose.data() + bone_offset[leg], pose.data() + bone_offset[leg] + n, state.angles);
+      for (int f = 0; f < frames;) {
+        if (contact[f * kLegCount + leg] > 0) {
+          const Vec3& goal = planned[f * kLegCount + leg];
+          record(f, goal, state.angles, advance(state, local_goal(f, goal), true, f < 2, nullptr));
+          ++f;
           continue;
         }
-        last_target = goal2;
-        // Warm start from the previous frame (seed 3.2), carried on by its change from
-        // the frame before: a planted foot's angles move smoothly, so this lands close.
-        if (f >= 2) {
-          for (int bone = 0; bone < n; ++bone) {
-            const Real last = angles[bone];
-            angles[bone] = last + (last - previous[bone]);
-            previous[bone] = last;
+        // A swing, frames [f, g), is solved as a whole: see solve_swing below.
+        int g = f;
+        while (g < frames && contact[g * kLegCount + leg] == 0) ++g;
+        const int count = g - f;
+        std::vector<Vec3> goals(count);
+        std::vector<Vec2d> goals2(count);
+        auto set_goals = [&](Real scale) {
+          for (int i = 0; i < count; ++i) {
+            goals[i] = planned[(f + i) * kLegCount + leg];
+            goals[i].z() -= (1 - scale) * lift[(f + i) * kLegCount + leg];
+            goals2[i] = local_goal(f + i, goals[i]);
           }
-        } else {
-          std::copy(angles, angles + n, previous);
+        };
+        // Forward from the lift-off pose, frame by frame with the warm start.
+        auto forward = [&](SwingTrack& track) {
+          track.angles.resize(static_cast<std::size_t>(count) * n);
+          track.error.resize(count);
+          track.worst = 0;
+          LegIkState st = state;
+          for (int i = 0; i < count; ++i) {
+            track.error[i] = advance(st, goals2[i], false, f + i < 2, nullptr);
+            track.worst = std::max(track.worst, track.error[i]);
+            std::copy(st.angles, st.angles + n, track.angles.begin() + i * n);
+          }
+        };
+        set_goals(kLiftScales[0]);
+        SwingTrack best;
+        forward(best);
+        Real best_scale = kLiftScales[0];
+        if (best.worst > kSwingTolerance) {
+          // The warm start folded into a corner of the limits it cannot leave without a
+          // jump, or the lift carries the hoof past what the limits allow. The landing
+          // pose (what the planted foot's solve, restarts allowed, finds) solved
+          // backwards in time gives the other branch; where both follow the path the
+          // pose crosses from one to the other, each frame re-solved from a blend of
+          // the two. Failing that, the same with less lift. First that follows wins.
+          Real landing[kMaxBones];
+          std::copy(state.angles, state.angles + n, landing);
+          if (g < frames) {
+            solve_ccd(chain, local_goal(g, planned[g * kLegCount + leg]), in.ccd_iterations, kIkTolerance, landing, true);
+          }
+          for (Real scale : kLiftScales) {
+            set_goals(scale);
+            SwingTrack ahead, back, crossed;
+            forward(ahead);
+            if (ahead.worst < best.worst) {
+              best = ahead;
+              best_scale = scale;
+            }
+            if (ahead.worst <= kSwingTolerance) break;
+            back.angles.resize(static_cast<std::size_t>(count) * n);
+            back.error.resize(count);
+            LegIkState st;
+            std::copy(landing, landing + n, st.angles);
+            std::copy(landing, landing + n, st.previous);
+            for (int i = count - 1; i >= 0; --i) {
+              back.error[i] = advance(st, goals2[i], false, false, nullptr);
+              std::copy(st.angles, st.angles + n, back.angles.begin() + i * n);
+            }
+            int ahead_end = 0;  // frames [0, ahead_end) follow going forward
+            while (ahead_end < count && ahead.error[ahead_end] <= kSwingTolerance) ++ahead_end;
+            int back_start = count;  // frames [back_start, count) follow going backward
+            while (back_start > 0 && back.error[back_start - 1] <= kSwingTolerance) --back_start;
+            if (back_start >= ahead_end) continue;  // no frame both follow: no crossing
+            const int w0 = back_start, w1 = ahead_end;  // crossing window [w0, w1)
+            crossed = ahead;
+            crossed.worst = 0;
+            LegIkState cs = state;
+            for (int i = 0; i < count; ++i) {
+              Real seed[kMaxBones];
+              const Real* a = ahead.angles.data() + i * n;
+              const Real* b = back.angles.data() + i * n;
+              const Real t = std::clamp(static_cast<Real>(i - w0 + 1) / (w1 - w0 + 1), Real(0), Real(1));
+              const Real w = t * t * (3 - 2 * t);
+              for (int bone = 0; bone < n; ++bone) seed[bone] = a[bone] + w * (b[bone] - a[bone]);
+              crossed.error[i] = advance(cs, goals2[i], false, false, seed);
+              crossed.worst = std::max(crossed.worst, crossed.error[i]);
+              std::copy(cs.angles, cs.angles + n, crossed.angles.begin() + i * n);
+            }
+            if (crossed.worst < best.worst) {
+              best = crossed;
+              best_scale = scale;
+            }
+            if (crossed.worst <= kSwingTolerance) break;
+          }
+          set_goals(best_scale);
         }
-        const Vec3& target = planned[f * kLegCount + leg];
-        for (int c = 0; c < 3; ++c) out.feet_planned[(f * kLegCount + leg) * 3 + c] = target[c];
-        const Vec3 local = rotations[f].transpose() * (target - heads[f]) + rig.body_head;  // rest space
-        const CcdResult r = solve_ccd(chains[leg], Vec2d(local.dot(F), local.z()), in.ccd_iterations, kIkTolerance,
-                                       angles, contact[f * kLegCount + leg] > 0);
-        out.ik_error[f * 4 + leg] = r.error;
-        last_error = r.error;
-        for (int bone = 0; bone < chains[leg].size(); ++bone) {
-          out.angles[static_cast<std::size_t>(f) * out.bones + bone_offset[leg] + bone] = angles[bone];
-        }
+        for (int i = 0; i < count; ++i) record(f + i, goals[i], best.angles.data() + i * n, best.error[i]);
+        // Carry the warm start on from the swing's last two poses.
+        std::copy(best.angles.end() - n, best.angles.end(), state.angles);
+        if (count >= 2) std::copy(best.angles.end() - 2 * n, best.angles.end() - n, state.previous);
+        state.last_target = goals2[count - 1];
+        state.last_error = best.error[count - 1];
+        f = g;
       }
     }
   });
