@@ -18,6 +18,7 @@ constexpr Real kStandSpeed = 1e-4;   // below this the clocks of planted legs pa
 constexpr Real kReachMargin = 0.93;  // IK targets stay inside 93% of what the chain reaches
 constexpr int kReachSamples = 64;
 constexpr Real kIkTolerance = 2e-4;  // m: a planted foot is solved to a fifth of a millimetre
+constexpr Real kSwingIkTolerance = 1e-3;  // m: a swinging foot, to a millimetre
 constexpr int kMaxBones = 6;
 // A swing the leg cannot follow within this (m) is re-planned lower (see the IK pass).
 constexpr Real kSwingTolerance = 0.01;
@@ -322,8 +323,10 @@ BakeOutput bake_gait(const BakeInput& in) {
 
   // --- body height and pitch per frame ------------------------------------------
   // Bob (seed: measured body bob replayed) as a dip accumulated in phase so a change
-  // of cycle time never makes it jump; then the body is lowered wherever a planted
-  // foot would be out of its leg's reach, fore and hind apart (that gives pitch).
+  // of cycle time never makes it jump; then the body is lowered wherever a foot, planted
+  // or swinging, would be out of its leg's reach, fore and hind apart (that gives pitch).
+  // Swinging feet count too: a hoof just lifted far behind its root (at 24 fps a frame
+  // can find it there) or about to land far ahead must be reachable.
   std::vector<Real> drop_fore(frames), drop_hind(frames), bob(frames);
   {
     Real phase = 0, amplitude = table.gaits[gait[0]].bob;
@@ -341,7 +344,6 @@ BakeOutput bake_gait(const BakeInput& in) {
     const long k = static_cast<long>(f) * substeps;
     Real need[2] = {0, 0};
     for (int leg = 0; leg < kLegCount; ++leg) {
-      if (contact[f * kLegCount + leg] == 0) continue;
       const Vec3& foot = planned[f * kLegCount + leg];
       const Vec2d root2 = root_at(leg, k);
       const Real dx = (horizontal(foot) - root2).dot(body[k].heading);
@@ -479,7 +481,19 @@ BakeOutput bake_gait(const BakeInput& in) {
           angles[bone] = seed ? seed[bone] : first_frames ? last : last + (last - st.previous[bone]);
           st.previous[bone] = last;
         }
-        st.last_error = solve_ccd(chain, goal2, in.ccd_iterations, kIkTolerance, angles, planted).error;
+        const Real tolerance = planted ? kIkTolerance : kSwingIkTolerance;
+        st.last_error = solve_ccd(chain, goal2, in.ccd_iterations, tolerance, angles, planted).error;
+        if (!planted && !seed && !first_frames && st.last_error > kSwingTolerance) {
+          // At lift-off the foot turns back on its root: carried on, the warm start can
+          // overshoot into a limit the solve cannot leave. The plain previous pose then.
+          Real plain[kMaxBones];
+          std::copy(st.previous, st.previous + n, plain);
+          const Real error = solve_ccd(chain, goal2, in.ccd_iterations, tolerance, plain, false).error;
+          if (error < st.last_error) {
+            std::copy(plain, plain + n, angles);
+            st.last_error = error;
+          }
+        }
         return st.last_error;
       };
       LegIkState state;
@@ -533,14 +547,16 @@ BakeOutput bake_gait(const BakeInput& in) {
             solve_ccd(chain, local_goal(g, planned[g * kLegCount + leg]), in.ccd_iterations, kIkTolerance, landing, true);
           }
           for (Real scale : kLiftScales) {
-            set_goals(scale);
-            SwingTrack ahead, back, crossed;
-            forward(ahead);
-            if (ahead.worst < best.worst) {
-              best = ahead;
-              best_scale = scale;
+            SwingTrack ahead = best, back, crossed;  // the full lift's forward solve is `best`
+            if (scale != kLiftScales[0]) {
+              set_goals(scale);
+              forward(ahead);
+              if (ahead.worst < best.worst) {
+                best = ahead;
+                best_scale = scale;
+              }
+              if (ahead.worst <= kSwingTolerance) break;
             }
-            if (ahead.worst <= kSwingTolerance) break;
             back.angles.resize(static_cast<std::size_t>(count) * n);
             back.error.resize(count);
             LegIkState st;
