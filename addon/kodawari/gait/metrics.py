@@ -54,16 +54,20 @@ def swing_smoothness(feet, contacts, leg, lo, hi, fps):
 
     A jump is a one-frame move that stands out from both neighbouring moves: its ratio
     is step / max(previous step, next step), about 1 on a smooth path whatever the
-    frame rate, and the jump is by how much the step exceeds them."""
+    frame rate, and the jump is by how much the step exceeds them. Every swing that
+    overlaps frames [lo, hi) is measured whole, from lift-off to landing: a swing cut
+    at a gait change would lose the neighbour of its first or last step."""
     c = contacts[:, leg] > 0.5
     jump, ratio, accel = 0.0, 0.0, 0.0
     f = lo
+    while 0 < f < len(c) and not c[f] and not c[f - 1]:
+        f -= 1  # back to the lift-off of a swing already under way at lo
     while f < hi:
         if c[f]:
             f += 1
             continue
         g = f
-        while g < hi and not c[g]:
+        while g < len(c) and not c[g]:
             g += 1
         a, b = max(f - 1, 0), min(g + 1, len(c))  # include the planted frames on both sides
         path = feet[a:b, leg]

@@ -112,7 +112,7 @@ CcdResult solve_ccd(const LegChain& chain, const Vec2& target, int iterations, R
   }
   // The seed's CCD with joint stiffness shapes the pose (the femur leads, not the hoof).
   CcdResult result = ccd_sweeps(chain, target, iterations, tolerance, true, angles);
-  if (result.error <= tolerance || !allow_restart) return result;
+  if (result.error <= tolerance) return result;
   // Stiffness slows convergence; when it stalls, plain CCD closes the remaining gap
   // from that pose, so a reachable planted foot is really reached.
   Real polished[kMaxBones];
@@ -123,7 +123,7 @@ CcdResult solve_ccd(const LegChain& chain, const Vec2& target, int iterations, R
     std::copy(polished, polished + n, angles);
     result = polish;
   }
-  if (result.error <= tolerance) return result;
+  if (result.error <= tolerance || !allow_restart) return result;
   // A warm start can sit in a corner of the limits; cold starts from the rest pose and
   // from the middle of the limits find the other branches. Keep whichever lands
   // closest: the foot then moves by at most the warm start's miss.

@@ -40,10 +40,11 @@ struct CcdResult {
 // the new one. From the last bone up, each joint turns so the line from it to the foot
 // points at the target, scaled by its stiffness and clamped to its limits. An
 // unreachable target leaves the chain stretched towards it: stable, never NaN.
-// With allow_restart (a planted foot, which must be reached) a stalled solve is
-// finished by plain CCD (stiffness 1) and, if still more than 1 mm away, retried from
-// cold starts (limits freed, rest pose, middle of the limits), keeping the closest. A
-// swinging foot is solved by the stiff CCD alone, so it never jumps between branches.
+// A stalled stiff solve is finished by plain CCD (stiffness 1) from where it stalled.
+// With allow_restart (a planted foot, which must be reached) a solve still more than
+// 1 mm away is retried from cold starts (limits freed, rest pose, middle of the
+// limits), keeping the closest. A swinging foot gets no cold restart, so it never
+// jumps between branches (the bake's leg IK crosses branches smoothly: leg_ik.cpp).
 CcdResult solve_ccd(const LegChain& chain, const Vec2& target, int iterations, Real tolerance, Real* angles,
                     bool allow_restart = true);
 
