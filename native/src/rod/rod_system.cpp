@@ -33,11 +33,12 @@ bool finite(const Quat& q) { return q.coeffs().allFinite(); }
 // Spin integration to first order, q <- normalise([1, ω dt / 2] q), and its exact inverse
 // ω = 2 vec(dq) / (w(dq) dt): consistent with each other and free of sin/cos/atan2, which
 // matters at tens of thousands of particles per substep (dt ω is small at these rates).
-Quat exp_rotation(const Vec3& rotation_vector) {
-  return Quat(1, rotation_vector.x() / 2, rotation_vector.y() / 2, rotation_vector.z() / 2).normalized();
+Quat spin(const Quat& q, const Vec3& rotation_vector) {
+  const Vec3 half = rotation_vector / 2;
+  return (Quat(1, half.x(), half.y(), half.z()) * q).normalized();
 }
 
-// Angular velocity that turns `from` into `to` in dt (inverse of exp_rotation).
+// Angular velocity that turns `from` into `to` in dt (inverse of spin).
 Vec3 angular_velocity(const Quat& from, const Quat& to, Real dt) {
   Quat dq = to * from.conjugate();
   if (dq.w() < 0) dq.coeffs() = -dq.coeffs();
@@ -150,8 +151,8 @@ namespace {
 // Rest particles in the anchor frame (see the header for the particle layout).
 void rest_particles(const ChainGeometry& g, const QuatList& rest, Vec3List& x_rest, QuatList& q_rest) {
   const std::size_t n = g.bone_count();
-  QuatList frames;
-  Vec3List heads;
+  thread_local QuatList frames;
+  thread_local Vec3List heads;
   chain_forward_kinematics(g, rest, frames, heads);
   x_rest.resize(n + 2);
   q_rest.resize(n + 2);
@@ -201,10 +202,17 @@ void RodSystem::begin_frame(std::size_t r, const FrameInput& input, const std::v
     has_view = view.norm() > 1e-9;
     if (has_view) view.normalize();
   }
-  std::vector<Real> similarities(rod.keys.size()), influences(rod.keys.size());
+  // Per-thread buffers: a frame of a thousand rods allocates nothing here.
+  thread_local std::vector<Real> similarities, influences;
+  thread_local std::vector<const QuatList*> shapes;
+  thread_local QuatList rest;
+  similarities.resize(rod.keys.size());
+  influences.resize(rod.keys.size());
+  shapes.clear();
   for (std::size_t i = 0; i < rod.keys.size(); ++i) {
     const RodKey& key = rod.keys[i];
     influences[i] = key.influence;
+    shapes.push_back(&key.shape);
     switch (key.condition) {
       case Condition::View:
         // No camera (or a camera inside the joint): view keys drop out, the base shape takes over.
@@ -219,10 +227,7 @@ void RodSystem::begin_frame(std::size_t r, const FrameInput& input, const std::v
     }
   }
   weights_[r] = condition_weights(similarities, influences);
-  std::vector<QuatList> shapes;
-  shapes.reserve(rod.keys.size());
-  for (const RodKey& key : rod.keys) shapes.push_back(key.shape);
-  QuatList rest = blend_shapes(shapes, weights_[r], n);
+  blend_shapes_into(shapes.data(), shapes.size(), weights_[r].data(), n, rest);
 
   if (reset || !s.initialised) {
     Quat parent_rotation;
@@ -281,6 +286,37 @@ void RodSystem::begin_frame(std::size_t r, const FrameInput& input, const std::v
   s.rest_local = rest;
 }
 
+namespace {
+
+// Per-thread work arrays of simulate(), reused from rod to rod and frame to frame:
+// the substep loop allocates nothing.
+struct SimulationScratch {
+  Vec3List x_rest;
+  QuatList q_rest, q_rest_conjugate, new_q;
+  std::vector<Real> lengths, inverse_hits;
+  // Per group c (members c-1, c, c+1 clipped to the chain): member weights w_i / mass,
+  // rest offsets from the rest centroid r_i = x̄_i - c̄, and w_i r_i (so that
+  // A = Σ w_i (x_i - c)(x̄_i - c̄)ᵀ = Σ x_i (w_i r_i)ᵀ, because Σ w_i r_i = 0).
+  std::vector<Real> group_weights;   // 3 per group: w_i / mass
+  std::vector<Real> group_ellipsoid; // 3 per group: w_i e
+  Vec3List group_rest, group_weighted_rest;  // 3 per group
+  std::vector<Mat3, Eigen::aligned_allocator<Mat3>> orientation_terms;
+  QuatList orientation_quats;
+  Vec3List displacement;
+};
+
+SimulationScratch& simulation_scratch() {
+  thread_local SimulationScratch scratch;
+  return scratch;
+}
+
+// The rotation matrix of a unit quaternion (as Eigen's toRotationMatrix, inlined here).
+inline Mat3 rotation_matrix(const Quat& q) {
+  return q.toRotationMatrix();
+}
+
+}  // namespace
+
 void RodSystem::simulate(std::size_t r, const FrameInput& input, const std::vector<Collider>& colliders) {
   const RodDefinition& rod = rods_[r];
   const RodParams& p = rod.params;
@@ -307,106 +343,163 @@ void RodSystem::simulate(std::size_t r, const FrameInput& input, const std::vect
   s.time_accumulator = std::max(Real(0), s.time_accumulator - Real(steps) / rate);
   steps = std::min(steps, kMaxSubstepsPerFrame);
 
-  Vec3List x_rest;
-  QuatList q_rest;
-  rest_particles(rod.geometry, s.rest_local, x_rest, q_rest);
-  std::vector<Real> lengths(n);
-  for (std::size_t k = 0; k < n; ++k) lengths[k] = rod.geometry.segment_length(k);
+  // Everything below that depends only on the rest shape is computed once per frame.
+  SimulationScratch& w = simulation_scratch();
+  rest_particles(rod.geometry, s.rest_local, w.x_rest, w.q_rest);
+  const Vec3List& x_rest = w.x_rest;
+  const QuatList& q_rest = w.q_rest;
+  w.q_rest_conjugate.resize(count);
+  for (std::size_t j = 0; j < count; ++j) w.q_rest_conjugate[j] = q_rest[j].conjugate();
+  w.lengths.resize(n);
+  for (std::size_t k = 0; k < n; ++k) w.lengths[k] = rod.geometry.segment_length(k);
   const Real ellipsoid = [&] {
     Real mean = 0;
-    for (Real l : lengths) mean += l;
+    for (Real l : w.lengths) mean += l;
     mean /= Real(n);
     return (mean * mean) / 5;  // a sphere of radius one segment: a²/5
   }();
+  // Particle j >= 2 belongs to the groups j-1, j and j+1 (those that exist): the Jacobi average.
+  w.inverse_hits.assign(count, Real(0));
+  for (std::size_t j = 2; j < count; ++j) w.inverse_hits[j] = Real(1) / Real(j + 1 < count ? 3 : 2);
+  w.group_weights.assign(3 * count, Real(0));
+  w.group_ellipsoid.assign(3 * count, Real(0));
+  w.group_rest.assign(3 * count, Vec3::Zero());
+  w.group_weighted_rest.assign(3 * count, Vec3::Zero());
+  for (std::size_t c = 1; c < count; ++c) {
+    const std::size_t lo = c - 1;
+    const std::size_t members = std::min(c + 1, count - 1) - lo + 1;
+    Real mass = 0;
+    Vec3 c_rest = Vec3::Zero();
+    for (std::size_t i = 0; i < members; ++i) {
+      // Ghost and root are kinematic: heavier in the fit.
+      const Real wi = (lo + i) <= 1 ? kKinematicWeight : Real(1);
+      mass += wi;
+      c_rest += wi * x_rest[lo + i];
+      w.group_ellipsoid[3 * c + i] = wi * ellipsoid;
+    }
+    c_rest /= mass;
+    for (std::size_t i = 0; i < members; ++i) {
+      const Real wi = (lo + i) <= 1 ? kKinematicWeight : Real(1);
+      w.group_weights[3 * c + i] = wi / mass;
+      w.group_rest[3 * c + i] = x_rest[lo + i] - c_rest;
+      w.group_weighted_rest[3 * c + i] = wi * w.group_rest[3 * c + i];
+    }
+  }
 
   const Mat3 world_to_armature = input.armature_matrix.block<3, 3>(0, 0).inverse();
   const Vec3 gravity = world_to_armature * (input.gravity * p.gravity);
   const Real dt = 1 / rate;
+  const Real inverse_dt = rate;
   const Real decay = std::exp(-p.damping * dt);
+  const Real stiffness = p.stiffness;
 
-  std::vector<Mat3, Eigen::aligned_allocator<Mat3>> rest_frames(count), orientation_terms(count);
-  for (std::size_t j = 0; j < count; ++j) rest_frames[j] = q_rest[j].toRotationMatrix().transpose();
-  Vec3List displacement(count);
-  std::vector<int> hits(count);
-  QuatList new_q(count);
-  Vec3 goals[3];
-  Real weights[3];
+  w.orientation_terms.resize(count);
+  w.orientation_quats.resize(count);
+  w.displacement.resize(count);
+  w.new_q.resize(count);
+  Vec3* x = s.x.data();
+  Quat* q = s.q.data();
   for (long step = 1; step <= steps; ++step) {
     const Real f = Real(step) / Real(steps);
     const Vec3 anchor = anchor_start + f * (anchor_end - anchor_start);
     const Quat anchor_rotation = anchor_start_rotation.slerp(f, anchor_end_rotation).normalized();
-    s.x[0] = anchor + anchor_rotation * x_rest[0];
-    s.q[0] = anchor_rotation;
-    s.x[1] = anchor;
+    x[0] = anchor + anchor_rotation * x_rest[0];
+    q[0] = anchor_rotation;
+    x[1] = anchor;
 
     // Wind with gusts: GLM Perlin noise over time, one noise line per rod (deterministic).
-    const Real t = input.time - (1 - f) * input.frame_dt;
-    const Real gust = 1 + kGustAmount * Real(glm::perlin(glm::dvec2(t * kGustFrequency, 0.37 * Real(r) + 0.5)));
-    const Vec3 wind = world_to_armature * (p.wind * gust);
     const bool windy = p.wind.squaredNorm() > 0;
+    Vec3 wind = Vec3::Zero();
+    if (windy) {
+      const Real t = input.time - (1 - f) * input.frame_dt;
+      const Real gust = 1 + kGustAmount * Real(glm::perlin(glm::dvec2(t * kGustFrequency, 0.37 * Real(r) + 0.5)));
+      wind = world_to_armature * (p.wind * gust);
+    }
 
     // Predict.
     for (std::size_t j = 2; j < count; ++j) {
       Vec3 a = gravity;
       if (windy) a += kWindDrag * (wind - s.v[j]);
       s.v[j] = decay * s.v[j] + dt * a;
-      s.prev_x[j] = s.x[j];
-      s.x[j] += dt * s.v[j];
+      s.prev_x[j] = x[j];
+      x[j] += dt * s.v[j];
     }
     for (std::size_t j = 1; j < count; ++j) {
       s.omega[j] *= decay;
-      s.prev_q[j] = s.q[j];
-      s.q[j] = (exp_rotation(s.omega[j] * dt) * s.q[j]).normalized();
+      s.prev_q[j] = q[j];
+      q[j] = spin(q[j], s.omega[j] * dt);
     }
 
     for (int it = 0; it < p.iterations; ++it) {
       // Shape matching over each particle's neighbourhood {c-1, c, c+1} (Jacobi: averaged).
-      std::fill(displacement.begin(), displacement.end(), Vec3::Zero());
-      std::fill(hits.begin(), hits.end(), 0);
-      for (std::size_t j = 0; j < count; ++j) orientation_terms[j] = s.q[j].toRotationMatrix() * rest_frames[j];
+      // E_j = R(q_j) R(q̄_j)ᵀ = R(q_j q̄_j⁻¹); that quaternion also warm-starts group j's fit.
+      for (std::size_t j = 0; j < count; ++j) {
+        w.orientation_quats[j] = q[j] * w.q_rest_conjugate[j];
+        w.orientation_terms[j] = rotation_matrix(w.orientation_quats[j]);
+      }
+      for (std::size_t j = 0; j < count; ++j) w.displacement[j].setZero();
       for (std::size_t c = 1; c < count; ++c) {
         const std::size_t lo = c - 1;
-        const std::size_t hi = std::min(c + 1, count - 1);
-        const int members = static_cast<int>(hi - lo + 1);
-        for (int i = 0; i < members; ++i) weights[i] = (lo + i) <= 1 ? kKinematicWeight : Real(1);
-        const Quat guess = s.q[c] * q_rest[c].conjugate();
-        const Quat R = match_group(&s.x[lo], &x_rest[lo], &orientation_terms[lo], weights, members, ellipsoid, guess,
-                                   goals);
-        for (int i = 0; i < members; ++i) {
+        const std::size_t members = c + 1 < count ? 3 : 2;
+        const Real* gw = &w.group_weights[3 * c];
+        const Real* ge = &w.group_ellipsoid[3 * c];
+        const Vec3* rest = &w.group_rest[3 * c];
+        const Vec3* weighted_rest = &w.group_weighted_rest[3 * c];
+        Vec3 centroid = gw[0] * x[lo] + gw[1] * x[lo + 1];
+        Mat3 A = x[lo] * weighted_rest[0].transpose() + x[lo + 1] * weighted_rest[1].transpose() +
+                 ge[0] * w.orientation_terms[lo] + ge[1] * w.orientation_terms[lo + 1];
+        if (members == 3) {
+          centroid += gw[2] * x[lo + 2];
+          A += x[lo + 2] * weighted_rest[2].transpose() + ge[2] * w.orientation_terms[lo + 2];
+        }
+        // Rotational part of A: one warm-started step of Müller et al. 2016 (see extract_rotation),
+        // from the guess q_c q̄_c⁻¹ whose matrix E_c is already at hand.
+        const Mat3& G = w.orientation_terms[c];
+        const Vec3 torque = G.col(0).cross(A.col(0)) + G.col(1).cross(A.col(1)) + G.col(2).cross(A.col(2));
+        const Real denom = std::abs(G.col(0).dot(A.col(0)) + G.col(1).dot(A.col(1)) + G.col(2).dot(A.col(2))) + 1e-12;
+        const Vec3 omega = torque * (Real(0.5) / denom);
+        Quat R = w.orientation_quats[c];
+        Mat3 Rm = G;
+        if (omega.squaredNorm() >= Real(0.25e-24)) {
+          R = (Quat(1, omega.x(), omega.y(), omega.z()) * R).normalized();
+          Rm = rotation_matrix(R);
+        }
+        for (std::size_t i = 0; i < members; ++i) {
           const std::size_t j = lo + i;
           if (j < 2) continue;
-          displacement[j] += goals[i] - s.x[j];
-          ++hits[j];
+          w.displacement[j] += Rm * rest[i] + centroid - x[j];
         }
-        new_q[c] = (R * q_rest[c]).normalized();
+        w.new_q[c] = R * q_rest[c];
       }
-      for (std::size_t j = 2; j < count; ++j) s.x[j] += p.stiffness * displacement[j] / Real(hits[j]);
+      for (std::size_t j = 2; j < count; ++j) x[j] += (stiffness * w.inverse_hits[j]) * w.displacement[j];
       for (std::size_t c = 1; c < count; ++c) {
-        Quat target = new_q[c];
-        if (target.dot(s.q[c]) < 0) target.coeffs() = -target.coeffs();
-        s.q[c].coeffs() = (1 - p.stiffness) * s.q[c].coeffs() + p.stiffness * target.coeffs();
-        s.q[c].normalize();
+        const Quat& target = w.new_q[c];
+        // Blend towards the (sign-aligned) target; the normalisation absorbs |target| != 1.
+        const Real sign = target.dot(q[c]) < 0 ? -stiffness : stiffness;
+        q[c].coeffs() = (1 - stiffness) * q[c].coeffs() + sign * target.coeffs();
+        q[c].normalize();
       }
       // Inextensibility: PBD distance constraints, root (kinematic) to tip.
-      for (std::size_t k = 0; k < n; ++k) project_distance(s.x[k + 1], s.x[k + 2], k == 0 ? 0 : 1, 1, lengths[k]);
+      for (std::size_t k = 0; k < n; ++k) project_distance(x[k + 1], x[k + 2], k == 0 ? 0 : 1, 1, w.lengths[k]);
       if (!colliders.empty()) {
-        for (std::size_t j = 2; j < count; ++j) push_out_of_colliders(s.x[j], colliders, p.radius);
+        for (std::size_t j = 2; j < count; ++j) push_out_of_colliders(x[j], colliders, p.radius);
       }
     }
     // Exact lengths from the root; a joint pushed out of a collider is re-pulled onto
     // its bone length, a few times, so both hold on output.
     for (std::size_t k = 0; k < n; ++k) {
-      Vec3& a = s.x[k + 1];
-      Vec3& b = s.x[k + 2];
+      Vec3& a = x[k + 1];
+      Vec3& b = x[k + 2];
       for (int pass = 0; pass < 4; ++pass) {
         const Vec3 d = b - a;
         const Real len = d.norm();
-        b = len > 1e-12 ? Vec3(a + d * (lengths[k] / len)) : Vec3(a + s.q[k + 1] * (lengths[k] * rod.geometry.segment_axis(k)));
+        b = len > 1e-12 ? Vec3(a + d * (w.lengths[k] / len))
+                        : Vec3(a + q[k + 1] * (w.lengths[k] * rod.geometry.segment_axis(k)));
         if (colliders.empty() || !push_out_of_colliders(b, colliders, p.radius)) break;
       }
     }
-    for (std::size_t j = 2; j < count; ++j) s.v[j] = (s.x[j] - s.prev_x[j]) / dt;
-    for (std::size_t j = 1; j < count; ++j) s.omega[j] = angular_velocity(s.prev_q[j], s.q[j], dt);
+    for (std::size_t j = 2; j < count; ++j) s.v[j] = (x[j] - s.prev_x[j]) * inverse_dt;
+    for (std::size_t j = 1; j < count; ++j) s.omega[j] = angular_velocity(s.prev_q[j], q[j], dt);
   }
   s.anchor_position = anchor_end;
   s.anchor_rotation = anchor_end_rotation;
@@ -424,7 +517,7 @@ void RodSystem::write_output(std::size_t r, float* rotations_out) {
   const RodDefinition& rod = rods_[r];
   RodState& s = states_[r];
   const std::size_t n = rod.bones.size();
-  QuatList frames;
+  thread_local QuatList frames;
   bone_frames(rod.geometry, s, frames);
   for (std::size_t k = 0; k < n; ++k) {
     const Quat parent = k == 0 ? s.anchor_rotation : Quat(frames[k - 1] * rod.geometry.rest_rotations[k]);
