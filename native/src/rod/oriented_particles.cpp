@@ -23,17 +23,6 @@ Quat extract_rotation(const Mat3& A, const Quat& guess, int max_iterations) {
   return q;
 }
 
-void project_distance(Vec3& a, Vec3& b, Real wa, Real wb, Real rest_length) {
-  const Real wsum = wa + wb;
-  if (wsum <= 0) return;
-  const Vec3 d = b - a;
-  const Real len = d.norm();
-  if (len < 1e-12) return;
-  const Vec3 correction = (len - rest_length) / (len * wsum) * d;
-  a += wa * correction;
-  b -= wb * correction;
-}
-
 bool push_out_of_colliders(Vec3& p, const std::vector<Collider>& colliders, Real margin) {
   bool moved = false;
   for (const Collider& c : colliders) {

@@ -28,6 +28,14 @@ constexpr Real kSubstepUnit = 24.0;
 constexpr long kMaxSubstepsPerFrame = 4096;
 
 bool finite(const Vec3& v) { return v.allFinite(); }
+
+// q / |q| with one division (Eigen's normalized() divides every coefficient): the
+// substep loop normalises three quaternions per particle.
+inline Quat unit(const Quat& q) {
+  Quat out;
+  out.coeffs() = q.coeffs() * (Real(1) / std::sqrt(q.coeffs().squaredNorm()));
+  return out;
+}
 bool finite(const Quat& q) { return q.coeffs().allFinite(); }
 
 // Spin integration to first order, q <- normalise([1, ω dt / 2] q), and its exact inverse
@@ -35,7 +43,7 @@ bool finite(const Quat& q) { return q.coeffs().allFinite(); }
 // matters at tens of thousands of particles per substep (dt ω is small at these rates).
 Quat spin(const Quat& q, const Vec3& rotation_vector) {
   const Vec3 half = rotation_vector / 2;
-  return (Quat(1, half.x(), half.y(), half.z()) * q).normalized();
+  return unit(Quat(1, half.x(), half.y(), half.z()) * q);
 }
 
 // Angular velocity that turns `from` into `to` in dt (inverse of spin).
@@ -461,7 +469,7 @@ void RodSystem::simulate(std::size_t r, const FrameInput& input, const std::vect
         Quat R = w.orientation_quats[c];
         Mat3 Rm = G;
         if (omega.squaredNorm() >= Real(0.25e-24)) {
-          R = (Quat(1, omega.x(), omega.y(), omega.z()) * R).normalized();
+          R = unit(Quat(1, omega.x(), omega.y(), omega.z()) * R);
           Rm = rotation_matrix(R);
         }
         for (std::size_t i = 0; i < members; ++i) {
@@ -476,11 +484,11 @@ void RodSystem::simulate(std::size_t r, const FrameInput& input, const std::vect
         const Quat& target = w.new_q[c];
         // Blend towards the (sign-aligned) target; the normalisation absorbs |target| != 1.
         const Real sign = target.dot(q[c]) < 0 ? -stiffness : stiffness;
-        q[c].coeffs() = (1 - stiffness) * q[c].coeffs() + sign * target.coeffs();
-        q[c].normalize();
+        q[c] = unit(Quat((1 - stiffness) * q[c].coeffs() + sign * target.coeffs()));
       }
       // Inextensibility: PBD distance constraints, root (kinematic) to tip.
-      for (std::size_t k = 0; k < n; ++k) project_distance(x[k + 1], x[k + 2], k == 0 ? 0 : 1, 1, w.lengths[k]);
+      project_distance(x[1], x[2], 0, 1, w.lengths[0]);
+      for (std::size_t k = 1; k < n; ++k) project_distance(x[k + 1], x[k + 2], 1, 1, w.lengths[k]);
       if (!colliders.empty()) {
         for (std::size_t j = 2; j < count; ++j) push_out_of_colliders(x[j], colliders, p.radius);
       }
@@ -569,11 +577,13 @@ Vec3List RodSystem::joint_velocities(std::size_t r) const {
 
 namespace {
 
+// Writes into a buffer sized by state_size() (no growth checks: a frame's snapshot is
+// a few megabytes at 16k bones).
 struct Writer {
-  std::vector<Real>& out;
-  void put(Real v) { out.push_back(v); }
-  void put(const Vec3& v) { out.insert(out.end(), {v.x(), v.y(), v.z()}); }
-  void put(const Quat& q) { out.insert(out.end(), {q.w(), q.x(), q.y(), q.z()}); }
+  Real* out;
+  void put(Real v) { *out++ = v; }
+  void put(const Vec3& v) { out[0] = v.x(); out[1] = v.y(); out[2] = v.z(); out += 3; }
+  void put(const Quat& q) { out[0] = q.w(); out[1] = q.x(); out[2] = q.y(); out[3] = q.z(); out += 4; }
 };
 
 struct Reader {
@@ -596,9 +606,8 @@ std::size_t RodSystem::state_size() const {
 }
 
 std::vector<Real> RodSystem::save_state() const {
-  std::vector<Real> out;
-  out.reserve(state_size());
-  Writer w{out};
+  std::vector<Real> out(state_size());
+  Writer w{out.data()};
   for (std::size_t r = 0; r < rods_.size(); ++r) {
     const RodState& s = states_[r];
     const std::size_t n = rods_[r].bones.size();
@@ -658,6 +667,42 @@ void RodSystem::load_state(const std::vector<Real>& state) {
     s.speed = rd.real();
     for (Real& v : weights_[r]) v = rd.real();
   }
+}
+
+std::size_t RodSystem::rod_bone_count() const {
+  std::size_t count = 0;
+  for (const RodDefinition& rod : rods_) count += rod.bones.size();
+  return count;
+}
+
+void RodSystem::store_frame(int frame, const float* rotations) {
+  FrameCache::Entry entry;
+  entry.state = save_state();
+  entry.rotations.resize(4 * rod_bone_count());
+  float* out = entry.rotations.data();
+  for (const RodDefinition& rod : rods_) {
+    for (int bone : rod.bones) {
+      std::copy_n(rotations + 4 * static_cast<std::size_t>(bone), 4, out);
+      out += 4;
+    }
+  }
+  cache_.store(frame, std::move(entry));
+}
+
+bool RodSystem::recall_frame(int frame, float* rotations_out, bool load) {
+  const FrameCache::Entry* entry = cache_.find(frame);
+  if (entry == nullptr) return false;
+  if (load) load_state(entry->state);
+  if (rotations_out != nullptr) {
+    const float* in = entry->rotations.data();
+    for (const RodDefinition& rod : rods_) {
+      for (int bone : rod.bones) {
+        std::copy_n(in, 4, rotations_out + 4 * static_cast<std::size_t>(bone));
+        in += 4;
+      }
+    }
+  }
+  return true;
 }
 
 }  // namespace kodawari::rod

@@ -13,8 +13,18 @@ namespace kodawari::rod {
 // from `guess`. Deterministic: a fixed iteration cap and a fixed tolerance.
 Quat extract_rotation(const Mat3& A, const Quat& guess, int max_iterations = 24);
 
-// PBD distance constraint between a and b with inverse masses wa, wb.
-void project_distance(Vec3& a, Vec3& b, Real wa, Real wb, Real rest_length);
+// PBD distance constraint between a and b with inverse masses wa, wb (inline: the
+// substep loop calls it once per segment).
+inline void project_distance(Vec3& a, Vec3& b, Real wa, Real wb, Real rest_length) {
+  const Real wsum = wa + wb;
+  if (wsum <= 0) return;
+  const Vec3 d = b - a;
+  const Real len = d.norm();
+  if (len < 1e-12) return;
+  const Vec3 correction = (len - rest_length) / (len * wsum) * d;
+  a += wa * correction;
+  b -= wb * correction;
+}
 
 struct Collider {
   Vec3 start;         // sphere centre, or capsule axis start
