@@ -308,7 +308,7 @@ struct SimulationScratch {
   // rest offsets from the rest centroid r_i = x̄_i - c̄, and w_i r_i (so that
   // A = Σ w_i (x_i - c)(x̄_i - c̄)ᵀ = Σ x_i (w_i r_i)ᵀ, because Σ w_i r_i = 0).
   std::vector<Real> group_weights;   // 3 per group: w_i / mass
-  std::vector<Real> group_ellipsoid; // 3 per group: w_i e
+  std::vector<Real> group_ellipsoid; // 3 per group: w_i e (groups with a kinematic member)
   Vec3List group_rest, group_weighted_rest;  // 3 per group
   std::vector<Mat3, Eigen::aligned_allocator<Mat3>> orientation_terms;
   QuatList orientation_quats;
@@ -455,13 +455,27 @@ void RodSystem::simulate(std::size_t r, const FrameInput& input, const std::vect
         const Real* ge = &w.group_ellipsoid[3 * c];
         const Vec3* rest = &w.group_rest[3 * c];
         const Vec3* weighted_rest = &w.group_weighted_rest[3 * c];
+        // A = Σ w_i (x_i - c)(x̄_i - c̄)ᵀ + e Σ w_i E_i: the ellipsoid term of Müller & Chentanez
+        // 2011 (e = a²/5) with each particle's orientation defines twist even on a chain.
+        const Mat3* E = &w.orientation_terms[lo];
         Vec3 centroid = gw[0] * x[lo] + gw[1] * x[lo + 1];
-        Mat3 A = x[lo] * weighted_rest[0].transpose() + x[lo + 1] * weighted_rest[1].transpose() +
-                 ge[0] * w.orientation_terms[lo] + ge[1] * w.orientation_terms[lo + 1];
+        Mat3 A = x[lo] * weighted_rest[0].transpose() + x[lo + 1] * weighted_rest[1].transpose();
+        Mat3 orientations;
+        if (lo >= 2) {
+          orientations = E[0] + E[1];  // dynamic particles all weigh 1
+        } else {
+          orientations = ge[0] * E[0] + ge[1] * E[1];
+        }
         if (members == 3) {
           centroid += gw[2] * x[lo + 2];
-          A += x[lo + 2] * weighted_rest[2].transpose() + ge[2] * w.orientation_terms[lo + 2];
+          A += x[lo + 2] * weighted_rest[2].transpose();
+          if (lo >= 2) {
+            orientations += E[2];
+          } else {
+            orientations += ge[2] * E[2];
+          }
         }
+        A += lo >= 2 ? Mat3(ellipsoid * orientations) : orientations;
         // Rotational part of A: one warm-started step of Müller et al. 2016 (see extract_rotation),
         // from the guess q_c q̄_c⁻¹ whose matrix E_c is already at hand.
         const Mat3& G = w.orientation_terms[c];
@@ -602,7 +616,7 @@ std::size_t RodSystem::state_size() const {
   std::size_t size = 0;
   for (std::size_t r = 0; r < rods_.size(); ++r) {
     const std::size_t n = rods_[r].bones.size();
-    size += 1 + (n + 2) * (3 + 3 + 4 + 3) + n * 8 + 3 + 4 + 3 + 2 + weights_[r].size();
+    size += 1 + (n + 2) * (3 + 3 + 4 + 3) + n * 4 + 3 + 4 + 3 + 2 + weights_[r].size();
   }
   return size;
 }
@@ -621,7 +635,6 @@ std::vector<Real> RodSystem::save_state() const {
       w.put(s.initialised ? s.omega[j] : Vec3::Zero());
     }
     for (std::size_t k = 0; k < n; ++k) {
-      w.put(s.initialised ? s.rest_local[k] : Quat::Identity());
       w.put(s.initialised ? s.last_output[k] : Quat::Identity());
     }
     w.put(s.anchor_position);
@@ -650,7 +663,7 @@ void RodSystem::load_state(const std::vector<Real>& state) {
     s.omega.resize(n + 2);
     s.prev_x.resize(n + 2);
     s.prev_q.resize(n + 2);
-    s.rest_local.resize(n);
+    s.rest_local.assign(n, Quat::Identity());
     s.last_output.resize(n);
     for (std::size_t j = 0; j < n + 2; ++j) {
       s.x[j] = rd.vec();
@@ -658,16 +671,20 @@ void RodSystem::load_state(const std::vector<Real>& state) {
       s.q[j] = rd.quat();
       s.omega[j] = rd.vec();
     }
-    for (std::size_t k = 0; k < n; ++k) {
-      s.rest_local[k] = rd.quat();
-      s.last_output[k] = rd.quat();
-    }
+    for (std::size_t k = 0; k < n; ++k) s.last_output[k] = rd.quat();
     s.anchor_position = rd.vec();
     s.anchor_rotation = rd.quat();
     s.reference_position = rd.vec();
     s.time_accumulator = rd.real();
     s.speed = rd.real();
     for (Real& v : weights_[r]) v = rd.real();
+    // The rest shape is not stored: it is always the blend of the keys with these weights
+    // (begin_frame), recomputed here bit for bit by the same function.
+    if (s.initialised) {
+      std::vector<const QuatList*> shapes;
+      for (const RodKey& key : rods_[r].keys) shapes.push_back(&key.shape);
+      blend_shapes_into(shapes.data(), shapes.size(), weights_[r].data(), n, s.rest_local);
+    }
   }
 }
 
