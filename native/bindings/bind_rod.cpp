@@ -306,7 +306,9 @@ void bind_rod(py::module_& m) {
       .def("cached_state", [](const RodSystem& self, int frame) -> py::object {
              const FrameCache::Entry* e = self.frame_cache().find(frame);
              if (e == nullptr) return py::none();
-             return to_array(e->state);
+             py::array_t<double> out(static_cast<py::ssize_t>(e->state_size));
+             std::copy_n(e->state.get(), e->state_size, out.mutable_data());
+             return out;
            }, py::arg("frame"), "A cached frame's full state (as save_state gives it), or None.")
       .def("cached_rotations", [](const RodSystem& self, int frame) -> py::object {
              const FrameCache::Entry* e = self.frame_cache().find(frame);

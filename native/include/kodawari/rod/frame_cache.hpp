@@ -4,6 +4,7 @@
 #pragma once
 
 #include <map>
+#include <memory>
 #include <optional>
 #include <vector>
 
@@ -14,7 +15,8 @@ namespace kodawari::rod {
 class FrameCache {
  public:
   struct Entry {
-    std::vector<Real> state;      // RodSystem::save_state()
+    std::unique_ptr<Real[]> state;  // RodSystem::save_state()'s values (state_size of them)
+    std::size_t state_size = 0;
     std::vector<float> rotations; // (rod bones, 4): every rod's bones, rod by rod, root first
   };
 

@@ -136,6 +136,11 @@ class RodSystem {
   void begin_frame(std::size_t r, const FrameInput& input, const std::vector<Collider>& colliders, bool reset);
   void simulate(std::size_t r, const FrameInput& input, const std::vector<Collider>& colliders);
   void write_output(std::size_t r, float* rotations_out);
+  std::size_t rod_state_size(std::size_t r) const;
+  void write_rod_state(std::size_t r, Real* out) const;
+  void read_rod_state(std::size_t r, const Real* in);
+  void write_state(Real* out) const;  // state_size() values
+  void read_state(const Real* in);
   std::vector<Collider> world_colliders(const FrameInput& input) const;
 
   std::size_t bone_count_;
