@@ -5,7 +5,8 @@ bangs that stay off the eyes from the front, and rabbit ears with three keyed vi
 The head moves and the camera orbits. Two identical rigs share the spot: "plain"
 (physics only) and "kodawari" (the same physics plus the keyed view shapes); each is
 rendered alone from four camera angles. Writes out/hair.blend and out/hair_sheet.png
-(top row plain physics, bottom row view-dependent; columns front, right, back, left).
+(top row plain physics, bottom row view-dependent; columns front, right, back, left;
+the rows and columns are labelled on the sheet).
 """
 
 import math
@@ -246,6 +247,68 @@ def render_tile(scene, path):
     return pixels
 
 
+# Sheet labels, drawn with NumPy (no fonts or PIL inside Blender): a 5x7 pixel font
+# (g, p, y reach two rows below the baseline) for the few letters the labels use, scaled up.
+ROW_LABELS = ("plain physics", "view-dependent")
+GLYPHS = {
+    "a": ("     ", "     ", " ### ", "    #", " ####", "#   #", " ####"),
+    "b": ("#    ", "#    ", "#### ", "#   #", "#   #", "#   #", "#### "),
+    "c": ("     ", "     ", " ####", "#    ", "#    ", "#    ", " ####"),
+    "d": ("    #", "    #", " ####", "#   #", "#   #", "#   #", " ####"),
+    "e": ("     ", "     ", " ### ", "#   #", "#####", "#    ", " ### "),
+    "f": ("  ## ", " #   ", "#### ", " #   ", " #   ", " #   ", " #   "),
+    "g": ("     ", "     ", " ####", "#   #", "#   #", "#   #", " ####", "    #", " ### "),
+    "h": ("#    ", "#    ", "#### ", "#   #", "#   #", "#   #", "#   #"),
+    "i": ("  #  ", "     ", " ##  ", "  #  ", "  #  ", "  #  ", " ### "),
+    "k": ("#    ", "#    ", "#  # ", "# #  ", "##   ", "# #  ", "#  # "),
+    "l": (" ##  ", "  #  ", "  #  ", "  #  ", "  #  ", "  #  ", " ### "),
+    "n": ("     ", "     ", "#### ", "#   #", "#   #", "#   #", "#   #"),
+    "o": ("     ", "     ", " ### ", "#   #", "#   #", "#   #", " ### "),
+    "p": ("     ", "     ", "#### ", "#   #", "#   #", "#   #", "#### ", "#    ", "#    "),
+    "r": ("     ", "     ", "# ###", "##   ", "#    ", "#    ", "#    "),
+    "s": ("     ", "     ", " ####", "#    ", " ### ", "    #", "#### "),
+    "t": (" #   ", " #   ", "#### ", " #   ", " #   ", " #  #", "  ## "),
+    "v": ("     ", "     ", "#   #", "#   #", "#   #", " # # ", "  #  "),
+    "w": ("     ", "     ", "#   #", "#   #", "# # #", "# # #", " # # "),
+    "y": ("     ", "     ", "#   #", "#   #", "#   #", "#   #", " ####", "    #", " ### "),
+    "-": ("     ", "     ", "     ", "#### ", "     ", "     ", "     "),
+    " ": ("     ",) * 7,
+}
+
+
+def text_mask(text, scale):
+    """Boolean (9 * scale, 6 * scale * len(text)) mask of `text`, one column of space per glyph."""
+    columns = [np.array([[c == "#" for c in row + " "] for row in (GLYPHS[ch] + ("     ",) * 2)[:9]])
+               for ch in text.lower()]
+    mask = np.concatenate(columns, axis=1)
+    return np.kron(mask, np.ones((scale, scale), dtype=bool))
+
+
+def draw_text(image, text, top, left, scale=3, color=(0.05, 0.05, 0.08)):
+    """Draws `text` into a top-row-first RGBA float image, on a light plate for contrast."""
+    mask = text_mask(text, scale)
+    pad = scale * 2
+    h, w = mask.shape
+    plate = image[top:top + h + 2 * pad, left:left + w + 2 * pad]
+    plate[..., :3] = 0.5 * plate[..., :3] + 0.5 * 0.95
+    region = image[top + pad:top + pad + h, left + pad:left + pad + w]
+    region[mask, :3] = color
+
+
+def labelled_sheet(rows, row_labels, column_labels, header=44):
+    """Stacks the rows (top first) under a header band naming the columns; names each row."""
+    width = rows[0].shape[1]
+    band = np.ones((header, width, 4), dtype=np.float32)
+    band[..., :3] = 0.85
+    sheet = np.concatenate([band] + list(rows), axis=0)
+    for c, label in enumerate(column_labels):
+        text_width = text_mask(label, 3).shape[1] + 12
+        draw_text(sheet, label, 4, c * TILE[0] + (TILE[0] - text_width) // 2)
+    for r, label in enumerate(row_labels):
+        draw_text(sheet, label, header + r * TILE[1] + 8, 8)
+    return sheet
+
+
 def main():
     os.makedirs(OUT, exist_ok=True)
     bpy.ops.wm.read_homefile(use_empty=True)
@@ -275,13 +338,14 @@ def main():
         row = []
         for view, frame in FRAMES.items():
             scene.frame_set(frame)
-            row.append(render_tile(scene, os.path.join(OUT, f"_hair_{collection.name}_{view}.png")))
+            tile = render_tile(scene, os.path.join(OUT, f"_hair_{collection.name}_{view}.png"))
+            row.append(tile[::-1])  # top row first, like the sheet is drawn below
             print(f"rendered {collection.name} {view} (frame {frame})")
         rows.append(np.concatenate(row, axis=1))
-    sheet = np.concatenate(rows[::-1], axis=0)  # Blender images start at the bottom: plain on top
+    sheet = labelled_sheet(rows, ROW_LABELS, list(FRAMES))
     height, width = sheet.shape[:2]
     image = bpy.data.images.new("hair_sheet", width, height)
-    image.pixels[:] = sheet.ravel()
+    image.pixels[:] = sheet[::-1].ravel()  # Blender images start at the bottom
     image.filepath_raw = os.path.join(OUT, "hair_sheet.png")
     image.file_format = "PNG"
     image.save()

@@ -1,6 +1,7 @@
 // kodawari_native: view weights and the rod system (one crossing per frame for all rods).
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
 
 #include <cstdint>
 #include <optional>
@@ -275,7 +276,47 @@ void bind_rod(py::module_& m) {
              } catch (const std::invalid_argument& e) {
                throw py::value_error(e.what());
              }
-           }, py::arg("state"));
+           }, py::arg("state"))
+      // The exact per-frame cache (scrubbing), kept natively: see rod/frame_cache.hpp.
+      .def("store_frame", [](RodSystem& self, int frame, const py::handle& rotations) {
+             auto r = checked_array<float>(rotations, "rotations", static_cast<py::ssize_t>(self.bone_count()), 4);
+             const float* data = r.data();
+             py::gil_scoped_release release;
+             self.store_frame(frame, data);
+           }, py::arg("frame"), py::arg("rotations"),
+           "Caches this frame: the full state and the rod bones' rows of rotations (B, 4).")
+      .def("recall_frame", [](RodSystem& self, int frame, const py::handle& rotations_out, bool load_state) {
+             float* out_data = nullptr;
+             py::array_t<float> out;
+             if (!rotations_out.is_none()) {
+               out = checked_output<float>(rotations_out, "rotations_out", static_cast<py::ssize_t>(self.bone_count()), 4);
+               out_data = out.mutable_data();
+             }
+             py::gil_scoped_release release;
+             return self.recall_frame(frame, out_data, load_state);
+           }, py::arg("frame"), py::arg("rotations_out") = py::none(), py::arg("load_state") = true,
+           "Loads a cached frame's state (if load_state) and writes its rod-bone rows into rotations_out;\n"
+           "False when the frame is not cached.")
+      .def("cached_frames", [](const RodSystem& self) { return self.frame_cache().frames(); },
+           "The cached frames, ascending.")
+      .def("latest_cached_frame_before", [](const RodSystem& self, int frame) {
+             return self.frame_cache().latest_before(frame);
+           }, py::arg("frame"), "The latest cached frame before `frame`, or None.")
+      .def("clear_cache", [](RodSystem& self) { self.frame_cache().clear(); })
+      .def("cached_state", [](const RodSystem& self, int frame) -> py::object {
+             const FrameCache::Entry* e = self.frame_cache().find(frame);
+             if (e == nullptr) return py::none();
+             py::array_t<double> out(static_cast<py::ssize_t>(e->state_size));
+             std::copy_n(e->state.get(), e->state_size, out.mutable_data());
+             return out;
+           }, py::arg("frame"), "A cached frame's full state (as save_state gives it), or None.")
+      .def("cached_rotations", [](const RodSystem& self, int frame) -> py::object {
+             const FrameCache::Entry* e = self.frame_cache().find(frame);
+             if (e == nullptr) return py::none();
+             py::array_t<float> out({static_cast<py::ssize_t>(e->rotations.size() / 4), py::ssize_t(4)});
+             std::copy(e->rotations.begin(), e->rotations.end(), out.mutable_data());
+             return out;
+           }, py::arg("frame"), "A cached frame's rod-bone rotations (rod bones, 4), rod by rod, root first.");
 }
 
 }  // namespace kodawari::bind

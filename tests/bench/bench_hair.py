@@ -10,6 +10,7 @@ Run: tools/run_bench.sh (Blender 3.4 with the add-on installed).
 """
 
 import math
+import os
 import time
 
 import bpy
@@ -59,22 +60,25 @@ def bench_kodawari(scene, obj):
     obj.kodawari_hair.enabled = False  # the handler stays out: we time the same work directly
     rt = runtime.ArmatureRuntime(obj)
     assert rt.system.rod_count == CHAINS and not rt.error
-    per_frame = []
+    per_frame, per_frame_cpu = [], []
     for frame in range(1, FRAMES + 1):
         scene.frame_set(frame)  # Blender evaluates the armature (not counted)
-        t0 = time.perf_counter()
+        t0, c0 = time.perf_counter(), time.process_time()
         rt.evaluate(obj, scene, frame)  # read parents, 4 substeps for every rod, write rotations
         per_frame.append(time.perf_counter() - t0)
+        per_frame_cpu.append(time.process_time() - c0)
     steady = np.array(per_frame[1:])  # frame 1 is a reset, not a step
+    steady_cpu = np.array(per_frame_cpu[1:])
     # The native step alone, on the same inputs (advances the state: fine for timing).
     armature = np.array([tuple(r) for r in obj.matrix_world], np.float64)
     camera = np.array([0.0, -5.0, 1.7])
     gravity = np.array([0.0, 0.0, -9.81])
-    native = []
+    native, native_cpu = [], []
     for i in range(20):
-        t0 = time.perf_counter()
+        t0, c0 = time.perf_counter(), time.process_time()
         rt.system.step(rt.matrices, armature, camera, gravity, 3.0 + i / 24, 1 / 24, rt.rotations)
         native.append(time.perf_counter() - t0)
+        native_cpu.append(time.process_time() - c0)
     # Whole frame including Blender's own pose evaluation of all bones, with the live handler.
     obj.kodawari_hair.enabled = True
     scene.frame_set(1)
@@ -90,7 +94,9 @@ def bench_kodawari(scene, obj):
         t0 = time.perf_counter()
         scene.frame_set(frame)
         baseline_frame.append(time.perf_counter() - t0)
-    return np.median(steady), np.median(native), np.median(full), np.median(baseline_frame)
+    return {"add_on": np.median(steady), "add_on_mean": steady.mean(), "add_on_cpu": np.median(steady_cpu),
+            "native": np.median(native), "native_cpu": np.median(native_cpu), "full": np.median(full),
+            "blender_only": np.median(baseline_frame)}
 
 
 class PythonJiggle:
@@ -141,26 +147,32 @@ def bench_python(scene, obj):
 def main():
     bpy.ops.wm.read_homefile(use_empty=True)
     scene = bpy.context.scene
+    load_before = os.getloadavg()[0]
     t0 = time.perf_counter()
     obj = build_rig(scene)
     bones = CHAINS * BONES
     print(f"set-up: {CHAINS} chains x {BONES} bones ({bones} rod bones) in {time.perf_counter() - t0:.1f} s")
-    add_on, native, full, blender_only = bench_kodawari(scene, obj)
+    k = bench_kodawari(scene, obj)
     python = bench_python(scene, obj)
     python_bones = BASELINE_CHAINS * BONES
-    per_bone = add_on / bones * 1e6
+    per_bone = k["add_on"] / bones * 1e6
     per_bone_python = python / python_bones * 1e6
     particle_substeps = CHAINS * BONES * SUBSTEPS
     print(f"kodawari, end to end per frame (read parents, {SUBSTEPS} substeps, write rotations): "
-          f"{add_on * 1e3:.2f} ms = {per_bone:.3f} us per bone per frame (target <= 1 us)")
-    print(f"  native step alone: {native * 1e3:.2f} ms = {native / particle_substeps * 1e9:.1f} ns per "
-          f"particle-substep ({particle_substeps} particle-substeps per frame)")
-    print(f"  whole frame_set with the live handler (incl. Blender's own pose evaluation): {full * 1e3:.1f} ms; "
-          f"without it: {blender_only * 1e3:.1f} ms")
+          f"{k['add_on'] * 1e3:.2f} ms = {per_bone:.3f} us per bone per frame (target <= 1 us); "
+          f"mean {k['add_on_mean'] * 1e3:.2f} ms; CPU time (all threads) {k['add_on_cpu'] * 1e3:.2f} ms")
+    print(f"  native step alone: {k['native'] * 1e3:.2f} ms = {k['native'] / particle_substeps * 1e9:.1f} ns per "
+          f"particle-substep ({particle_substeps} particle-substeps per frame, {os.cpu_count()} hardware threads); "
+          f"CPU time {k['native_cpu'] * 1e3:.2f} ms = {k['native_cpu'] / particle_substeps * 1e9:.1f} ns of CPU "
+          f"per particle-substep")
+    print(f"  whole frame_set with the live handler (incl. Blender's own pose evaluation): {k['full'] * 1e3:.1f} ms; "
+          f"without it: {k['blender_only'] * 1e3:.1f} ms")
     print(f"pure-Python per-bone spring (Wiggle 2 style, 1 step per frame) over {python_bones} bones: "
           f"{python * 1e3:.1f} ms = {per_bone_python:.1f} us per bone per frame")
     print(f"ratio: kodawari is {per_bone_python / per_bone:.0f}x faster per bone per frame "
           f"(Wiggle 2 itself was measured at about 115 us per bone per frame: {115 / per_bone:.0f}x)")
+    print(f"machine load (1-min load average) before / after: {load_before:.1f} / {os.getloadavg()[0]:.1f} "
+          f"on {os.cpu_count()} hardware threads: wall-clock figures grow with it, CPU times much less")
 
 
 main()

@@ -121,7 +121,36 @@ def test_scrubbing_back_is_exact_and_the_start_frame_resets(empty_scene):
         assert np.array_equal(rotations(obj, name), first[frame])
     empty_scene.frame_set(1)
     assert np.array_equal(rotations(obj, name), first[1])
-    assert list(_runtime(obj).cache) == [1]
+    assert _runtime(obj).cached_frames == [1]
+
+
+def test_reading_only_the_bones_the_solver_needs_gives_the_same_motion(empty_scene, monkeypatch):
+    # Large rigs read the few parent/reference matrices and non-rod rotations bone by bone
+    # instead of in bulk: the motion must not change, nor the animated non-rod bones.
+    from kodawari.hair import runtime
+
+    obj, rod, name = _setup(empty_scene)
+    _animate_head(obj)
+    head = obj.pose.bones["Head"]
+    for frame, angle in ((1, 0.0), (15, 0.5), (30, -0.3)):
+        head.rotation_quaternion = Euler((0.0, angle, angle), "XYZ").to_quaternion()
+        head.keyframe_insert("rotation_quaternion", frame=frame)
+    add_camera(empty_scene, "Front", (0, -4, 1.7))
+    runs = []
+    for ratio in (10 ** 9, 1):  # bulk foreach_get, then bone by bone
+        monkeypatch.setattr(runtime, "SPARSE_READ_RATIO", ratio)
+        runtime.invalidate(obj)
+        frames = []
+        for frame in range(1, 31):
+            empty_scene.frame_set(frame)
+            frames.append((rotations(obj, name), np.array(head.rotation_quaternion)))
+        rt = _runtime(obj)
+        assert (rt.matrix_bones is None) == (ratio > 1) and (rt.other_bones is None) == (ratio > 1)
+        runs.append(frames)
+    for (bulk, bulk_head), (sparse, sparse_head) in zip(*runs):
+        assert np.array_equal(bulk, sparse)
+        assert np.array_equal(bulk_head, sparse_head)
+    assert np.abs(runs[1][20][1] - np.array([1.0, 0, 0, 0])).max() > 0.05, "the head's own animation must survive"
 
 
 def test_camera_switching_by_markers_changes_the_keyed_shape_without_momentum(empty_scene):

@@ -197,8 +197,53 @@ def test_saved_state_continues_exactly():
             frames.append(out.copy())
         runs.append(np.array(frames))
     assert runs[0].tobytes() == runs[1].tobytes()
+    # A fresh system with the same rods (as after reopening a file) continues the same way:
+    # the state carries everything, the keyed rest shape included.
+    fresh, _ = _run_many(1, frames=0)
+    fresh.load_state(state)
+    system.load_state(state)
+    for r in range(fresh.rod_count):
+        np.testing.assert_array_equal(fresh.rest_shape(r), system.rest_shape(r))
+    fresh_out = np.zeros_like(out)
+    for frame in range(10):
+        matrices[0, 12] = 0.2 * frame
+        camera = np.array([3.0 * np.cos(frame), 3.0 * np.sin(frame), 0])  # the view keys' weights change
+        for s, o in ((system, out), (fresh, fresh_out)):
+            s.step(matrices, np.eye(4), camera, np.array([0, 0, -9.81]), 1 + frame / 24, 1 / 24, o)
+        assert fresh_out.tobytes() == out.tobytes()
     with pytest.raises(ValueError, match="state has"):
         system.load_state(state[:-1])
+
+
+def test_the_native_frame_cache_recalls_a_frame_exactly_and_continues_from_it():
+    chain = Chain(bones=5)
+    chain.reset()
+    chain.system.store_frame(1, chain.out)
+    written = {}
+    for frame in range(2, 12):
+        chain.head_position = np.array([0.05 * frame, 0.0, 0.0])
+        chain.step()
+        chain.system.store_frame(frame, chain.out)
+        written[frame] = (chain.out.copy(), chain.system.save_state(), chain.time)
+    assert chain.system.cached_frames() == list(range(1, 12))
+    assert chain.system.latest_cached_frame_before(7) == 6
+    assert chain.system.latest_cached_frame_before(1) is None
+    # Rotations come back rod by rod, root first (here the bones 1..5 in order).
+    np.testing.assert_array_equal(chain.system.cached_rotations(4), written[4][0][1:])
+    np.testing.assert_array_equal(chain.system.cached_state(4), written[4][1])
+    # Recall frame 6, play on: frames 7.. repeat bit for bit.
+    out = np.zeros_like(chain.out)
+    assert chain.system.recall_frame(6, out)
+    np.testing.assert_array_equal(out[1:], written[6][0][1:])
+    chain.time = written[6][2]
+    for frame in range(7, 12):
+        chain.head_position = np.array([0.05 * frame, 0.0, 0.0])
+        assert chain.step().tobytes() == written[frame][0].tobytes()
+    assert not chain.system.recall_frame(40, out)
+    chain.system.clear_cache()
+    assert chain.system.cached_frames() == [] and chain.system.cached_state(4) is None
+    with pytest.raises(ValueError, match="rotations"):
+        chain.system.store_frame(2, np.zeros((2, 4), np.float32))
 
 
 def test_the_substep_rate_does_not_depend_on_the_frame_rate():

@@ -466,7 +466,7 @@ class KODAWARI_OT_rod_bake(bpy.types.Operator):
         if self._chains is None:
             self._chains = [name for i in sorted(rt.rod_chains) for name in rt.rod_chains[i]]
         if self._frame >= self._start:
-            self._baked[self._frame] = rt.cache[self._frame][1].copy()
+            self._baked[self._frame] = rt.cached_rotations(self._frame)
         self._frame += 1
         return self._frame > self._end
 

@@ -23,43 +23,6 @@ Quat extract_rotation(const Mat3& A, const Quat& guess, int max_iterations) {
   return q;
 }
 
-Quat match_group(const Vec3* x, const Vec3* x_rest, const Mat3* orientation_terms, const Real* w, int count,
-                 Real ellipsoid, const Quat& guess, Vec3* goals) {
-  Real mass = 0;
-  Vec3 c = Vec3::Zero(), c_rest = Vec3::Zero();
-  for (int i = 0; i < count; ++i) {
-    mass += w[i];
-    c += w[i] * x[i];
-    c_rest += w[i] * x_rest[i];
-  }
-  c /= mass;
-  c_rest /= mass;
-  Mat3 A = Mat3::Zero();
-  for (int i = 0; i < count; ++i) {
-    A += w[i] * (x[i] - c) * (x_rest[i] - c_rest).transpose();
-    // Ellipsoid term of Müller & Chentanez 2011 (sphere of radius a: e = a²/5),
-    // with the particle's rest orientation: it defines twist even on a chain.
-    A += (w[i] * ellipsoid) * orientation_terms[i];
-  }
-  // Few iterations suffice: the guess is the group's rotation of the previous iteration
-  // or substep, so the polar decomposition converges over time (Müller et al. 2016).
-  const Quat R = extract_rotation(A, guess, 1);
-  const Mat3 Rm = R.toRotationMatrix();
-  for (int i = 0; i < count; ++i) goals[i] = Rm * (x_rest[i] - c_rest) + c;
-  return R;
-}
-
-void project_distance(Vec3& a, Vec3& b, Real wa, Real wb, Real rest_length) {
-  const Real wsum = wa + wb;
-  if (wsum <= 0) return;
-  const Vec3 d = b - a;
-  const Real len = d.norm();
-  if (len < 1e-12) return;
-  const Vec3 correction = (len - rest_length) / (len * wsum) * d;
-  a += wa * correction;
-  b -= wb * correction;
-}
-
 bool push_out_of_colliders(Vec3& p, const std::vector<Collider>& colliders, Real margin) {
   bool moved = false;
   for (const Collider& c : colliders) {
@@ -81,7 +44,13 @@ bool push_out_of_colliders(Vec3& p, const std::vector<Collider>& colliders, Real
 
 Quat align_axis(const Quat& q, const Vec3& axis_local, const Vec3& target_direction) {
   const Vec3 current = q * axis_local;
-  return (Quat::FromTwoVectors(current, target_direction) * q).normalized();
+  // The half-way quaternion (1 + a·b, a × b) is the minimal rotation from a to b up to
+  // its norm; one normalisation of the product does for both (a third of the square roots
+  // of Quat::FromTwoVectors). Near a half turn the axis is ill-defined: Eigen picks one.
+  const Real cosine = current.dot(target_direction);
+  if (cosine < Real(-1) + Real(1e-6)) return (Quat::FromTwoVectors(current, target_direction) * q).normalized();
+  const Vec3 axis = current.cross(target_direction);
+  return (Quat(1 + cosine, axis.x(), axis.y(), axis.z()) * q).normalized();
 }
 
 }  // namespace kodawari::rod

@@ -26,18 +26,29 @@ constexpr Real kGustAmount = 0.6;
 // Substep rate unit: `substeps` counts substeps per 1/24 s, whatever the scene's fps.
 constexpr Real kSubstepUnit = 24.0;
 constexpr long kMaxSubstepsPerFrame = 4096;
+// Rods per work chunk (threads take chunks as they go): about 0.2 ms of work at 16 bones.
+constexpr std::size_t kRodsPerChunk = 16;
 
 bool finite(const Vec3& v) { return v.allFinite(); }
+
+// q / |q| with one division (Eigen's normalized() divides every coefficient): the
+// substep loop normalises three quaternions per particle.
+inline Quat unit(const Quat& q) {
+  Quat out;
+  out.coeffs() = q.coeffs() * (Real(1) / std::sqrt(q.coeffs().squaredNorm()));
+  return out;
+}
 bool finite(const Quat& q) { return q.coeffs().allFinite(); }
 
 // Spin integration to first order, q <- normalise([1, ω dt / 2] q), and its exact inverse
 // ω = 2 vec(dq) / (w(dq) dt): consistent with each other and free of sin/cos/atan2, which
 // matters at tens of thousands of particles per substep (dt ω is small at these rates).
-Quat exp_rotation(const Vec3& rotation_vector) {
-  return Quat(1, rotation_vector.x() / 2, rotation_vector.y() / 2, rotation_vector.z() / 2).normalized();
+Quat spin(const Quat& q, const Vec3& rotation_vector) {
+  const Vec3 half = rotation_vector / 2;
+  return unit(Quat(1, half.x(), half.y(), half.z()) * q);
 }
 
-// Angular velocity that turns `from` into `to` in dt (inverse of exp_rotation).
+// Angular velocity that turns `from` into `to` in dt (inverse of spin).
 Vec3 angular_velocity(const Quat& from, const Quat& to, Real dt) {
   Quat dq = to * from.conjugate();
   if (dq.w() < 0) dq.coeffs() = -dq.coeffs();
@@ -150,8 +161,8 @@ namespace {
 // Rest particles in the anchor frame (see the header for the particle layout).
 void rest_particles(const ChainGeometry& g, const QuatList& rest, Vec3List& x_rest, QuatList& q_rest) {
   const std::size_t n = g.bone_count();
-  QuatList frames;
-  Vec3List heads;
+  thread_local QuatList frames;
+  thread_local Vec3List heads;
   chain_forward_kinematics(g, rest, frames, heads);
   x_rest.resize(n + 2);
   q_rest.resize(n + 2);
@@ -201,10 +212,17 @@ void RodSystem::begin_frame(std::size_t r, const FrameInput& input, const std::v
     has_view = view.norm() > 1e-9;
     if (has_view) view.normalize();
   }
-  std::vector<Real> similarities(rod.keys.size()), influences(rod.keys.size());
+  // Per-thread buffers: a frame of a thousand rods allocates nothing here.
+  thread_local std::vector<Real> similarities, influences;
+  thread_local std::vector<const QuatList*> shapes;
+  thread_local QuatList rest;
+  similarities.resize(rod.keys.size());
+  influences.resize(rod.keys.size());
+  shapes.clear();
   for (std::size_t i = 0; i < rod.keys.size(); ++i) {
     const RodKey& key = rod.keys[i];
     influences[i] = key.influence;
+    shapes.push_back(&key.shape);
     switch (key.condition) {
       case Condition::View:
         // No camera (or a camera inside the joint): view keys drop out, the base shape takes over.
@@ -219,10 +237,7 @@ void RodSystem::begin_frame(std::size_t r, const FrameInput& input, const std::v
     }
   }
   weights_[r] = condition_weights(similarities, influences);
-  std::vector<QuatList> shapes;
-  shapes.reserve(rod.keys.size());
-  for (const RodKey& key : rod.keys) shapes.push_back(key.shape);
-  QuatList rest = blend_shapes(shapes, weights_[r], n);
+  blend_shapes_into(shapes.data(), shapes.size(), weights_[r].data(), n, rest);
 
   if (reset || !s.initialised) {
     Quat parent_rotation;
@@ -281,6 +296,37 @@ void RodSystem::begin_frame(std::size_t r, const FrameInput& input, const std::v
   s.rest_local = rest;
 }
 
+namespace {
+
+// Per-thread work arrays of simulate(), reused from rod to rod and frame to frame:
+// the substep loop allocates nothing.
+struct SimulationScratch {
+  Vec3List x_rest;
+  QuatList q_rest, q_rest_conjugate, new_q;
+  std::vector<Real> lengths, inverse_hits;
+  // Per group c (members c-1, c, c+1 clipped to the chain): member weights w_i / mass,
+  // rest offsets from the rest centroid r_i = x̄_i - c̄, and w_i r_i (so that
+  // A = Σ w_i (x_i - c)(x̄_i - c̄)ᵀ = Σ x_i (w_i r_i)ᵀ, because Σ w_i r_i = 0).
+  std::vector<Real> group_weights;   // 3 per group: w_i / mass
+  std::vector<Real> group_ellipsoid; // 3 per group: w_i e (groups with a kinematic member)
+  Vec3List group_rest, group_weighted_rest;  // 3 per group
+  std::vector<Mat3, Eigen::aligned_allocator<Mat3>> orientation_terms;
+  QuatList orientation_quats;
+  Vec3List displacement;
+};
+
+SimulationScratch& simulation_scratch() {
+  thread_local SimulationScratch scratch;
+  return scratch;
+}
+
+// The rotation matrix of a unit quaternion (as Eigen's toRotationMatrix, inlined here).
+inline Mat3 rotation_matrix(const Quat& q) {
+  return q.toRotationMatrix();
+}
+
+}  // namespace
+
 void RodSystem::simulate(std::size_t r, const FrameInput& input, const std::vector<Collider>& colliders) {
   const RodDefinition& rod = rods_[r];
   const RodParams& p = rod.params;
@@ -307,106 +353,177 @@ void RodSystem::simulate(std::size_t r, const FrameInput& input, const std::vect
   s.time_accumulator = std::max(Real(0), s.time_accumulator - Real(steps) / rate);
   steps = std::min(steps, kMaxSubstepsPerFrame);
 
-  Vec3List x_rest;
-  QuatList q_rest;
-  rest_particles(rod.geometry, s.rest_local, x_rest, q_rest);
-  std::vector<Real> lengths(n);
-  for (std::size_t k = 0; k < n; ++k) lengths[k] = rod.geometry.segment_length(k);
+  // Everything below that depends only on the rest shape is computed once per frame.
+  SimulationScratch& w = simulation_scratch();
+  rest_particles(rod.geometry, s.rest_local, w.x_rest, w.q_rest);
+  const Vec3List& x_rest = w.x_rest;
+  const QuatList& q_rest = w.q_rest;
+  w.q_rest_conjugate.resize(count);
+  for (std::size_t j = 0; j < count; ++j) w.q_rest_conjugate[j] = q_rest[j].conjugate();
+  w.lengths.resize(n);
+  for (std::size_t k = 0; k < n; ++k) w.lengths[k] = rod.geometry.segment_length(k);
   const Real ellipsoid = [&] {
     Real mean = 0;
-    for (Real l : lengths) mean += l;
+    for (Real l : w.lengths) mean += l;
     mean /= Real(n);
     return (mean * mean) / 5;  // a sphere of radius one segment: a²/5
   }();
+  // Particle j >= 2 belongs to the groups j-1, j and j+1 (those that exist): the Jacobi average.
+  w.inverse_hits.assign(count, Real(0));
+  for (std::size_t j = 2; j < count; ++j) w.inverse_hits[j] = Real(1) / Real(j + 1 < count ? 3 : 2);
+  w.group_weights.assign(3 * count, Real(0));
+  w.group_ellipsoid.assign(3 * count, Real(0));
+  w.group_rest.assign(3 * count, Vec3::Zero());
+  w.group_weighted_rest.assign(3 * count, Vec3::Zero());
+  for (std::size_t c = 1; c < count; ++c) {
+    const std::size_t lo = c - 1;
+    const std::size_t members = std::min(c + 1, count - 1) - lo + 1;
+    Real mass = 0;
+    Vec3 c_rest = Vec3::Zero();
+    for (std::size_t i = 0; i < members; ++i) {
+      // Ghost and root are kinematic: heavier in the fit.
+      const Real wi = (lo + i) <= 1 ? kKinematicWeight : Real(1);
+      mass += wi;
+      c_rest += wi * x_rest[lo + i];
+      w.group_ellipsoid[3 * c + i] = wi * ellipsoid;
+    }
+    c_rest /= mass;
+    for (std::size_t i = 0; i < members; ++i) {
+      const Real wi = (lo + i) <= 1 ? kKinematicWeight : Real(1);
+      w.group_weights[3 * c + i] = wi / mass;
+      w.group_rest[3 * c + i] = x_rest[lo + i] - c_rest;
+      w.group_weighted_rest[3 * c + i] = wi * w.group_rest[3 * c + i];
+    }
+  }
 
   const Mat3 world_to_armature = input.armature_matrix.block<3, 3>(0, 0).inverse();
   const Vec3 gravity = world_to_armature * (input.gravity * p.gravity);
   const Real dt = 1 / rate;
+  const Real inverse_dt = rate;
   const Real decay = std::exp(-p.damping * dt);
+  const Real stiffness = p.stiffness;
 
-  std::vector<Mat3, Eigen::aligned_allocator<Mat3>> rest_frames(count), orientation_terms(count);
-  for (std::size_t j = 0; j < count; ++j) rest_frames[j] = q_rest[j].toRotationMatrix().transpose();
-  Vec3List displacement(count);
-  std::vector<int> hits(count);
-  QuatList new_q(count);
-  Vec3 goals[3];
-  Real weights[3];
+  w.orientation_terms.resize(count);
+  w.orientation_quats.resize(count);
+  w.displacement.resize(count);
+  w.new_q.resize(count);
+  Vec3* x = s.x.data();
+  Quat* q = s.q.data();
   for (long step = 1; step <= steps; ++step) {
     const Real f = Real(step) / Real(steps);
     const Vec3 anchor = anchor_start + f * (anchor_end - anchor_start);
     const Quat anchor_rotation = anchor_start_rotation.slerp(f, anchor_end_rotation).normalized();
-    s.x[0] = anchor + anchor_rotation * x_rest[0];
-    s.q[0] = anchor_rotation;
-    s.x[1] = anchor;
+    x[0] = anchor + anchor_rotation * x_rest[0];
+    q[0] = anchor_rotation;
+    x[1] = anchor;
 
     // Wind with gusts: GLM Perlin noise over time, one noise line per rod (deterministic).
-    const Real t = input.time - (1 - f) * input.frame_dt;
-    const Real gust = 1 + kGustAmount * Real(glm::perlin(glm::dvec2(t * kGustFrequency, 0.37 * Real(r) + 0.5)));
-    const Vec3 wind = world_to_armature * (p.wind * gust);
     const bool windy = p.wind.squaredNorm() > 0;
+    Vec3 wind = Vec3::Zero();
+    if (windy) {
+      const Real t = input.time - (1 - f) * input.frame_dt;
+      const Real gust = 1 + kGustAmount * Real(glm::perlin(glm::dvec2(t * kGustFrequency, 0.37 * Real(r) + 0.5)));
+      wind = world_to_armature * (p.wind * gust);
+    }
 
     // Predict.
     for (std::size_t j = 2; j < count; ++j) {
       Vec3 a = gravity;
       if (windy) a += kWindDrag * (wind - s.v[j]);
       s.v[j] = decay * s.v[j] + dt * a;
-      s.prev_x[j] = s.x[j];
-      s.x[j] += dt * s.v[j];
+      s.prev_x[j] = x[j];
+      x[j] += dt * s.v[j];
     }
     for (std::size_t j = 1; j < count; ++j) {
       s.omega[j] *= decay;
-      s.prev_q[j] = s.q[j];
-      s.q[j] = (exp_rotation(s.omega[j] * dt) * s.q[j]).normalized();
+      s.prev_q[j] = q[j];
+      q[j] = spin(q[j], s.omega[j] * dt);
     }
 
     for (int it = 0; it < p.iterations; ++it) {
       // Shape matching over each particle's neighbourhood {c-1, c, c+1} (Jacobi: averaged).
-      std::fill(displacement.begin(), displacement.end(), Vec3::Zero());
-      std::fill(hits.begin(), hits.end(), 0);
-      for (std::size_t j = 0; j < count; ++j) orientation_terms[j] = s.q[j].toRotationMatrix() * rest_frames[j];
+      // E_j = R(q_j) R(q̄_j)ᵀ = R(q_j q̄_j⁻¹); that quaternion also warm-starts group j's fit.
+      for (std::size_t j = 0; j < count; ++j) {
+        w.orientation_quats[j] = q[j] * w.q_rest_conjugate[j];
+        w.orientation_terms[j] = rotation_matrix(w.orientation_quats[j]);
+      }
+      for (std::size_t j = 0; j < count; ++j) w.displacement[j].setZero();
       for (std::size_t c = 1; c < count; ++c) {
         const std::size_t lo = c - 1;
-        const std::size_t hi = std::min(c + 1, count - 1);
-        const int members = static_cast<int>(hi - lo + 1);
-        for (int i = 0; i < members; ++i) weights[i] = (lo + i) <= 1 ? kKinematicWeight : Real(1);
-        const Quat guess = s.q[c] * q_rest[c].conjugate();
-        const Quat R = match_group(&s.x[lo], &x_rest[lo], &orientation_terms[lo], weights, members, ellipsoid, guess,
-                                   goals);
-        for (int i = 0; i < members; ++i) {
+        const std::size_t members = c + 1 < count ? 3 : 2;
+        const Real* gw = &w.group_weights[3 * c];
+        const Real* ge = &w.group_ellipsoid[3 * c];
+        const Vec3* rest = &w.group_rest[3 * c];
+        const Vec3* weighted_rest = &w.group_weighted_rest[3 * c];
+        // A = Σ w_i (x_i - c)(x̄_i - c̄)ᵀ + e Σ w_i E_i: the ellipsoid term of Müller & Chentanez
+        // 2011 (e = a²/5) with each particle's orientation defines twist even on a chain.
+        const Mat3* E = &w.orientation_terms[lo];
+        Vec3 centroid = gw[0] * x[lo] + gw[1] * x[lo + 1];
+        Mat3 A = x[lo] * weighted_rest[0].transpose() + x[lo + 1] * weighted_rest[1].transpose();
+        Mat3 orientations;
+        if (lo >= 2) {
+          orientations = E[0] + E[1];  // dynamic particles all weigh 1
+        } else {
+          orientations = ge[0] * E[0] + ge[1] * E[1];
+        }
+        if (members == 3) {
+          centroid += gw[2] * x[lo + 2];
+          A += x[lo + 2] * weighted_rest[2].transpose();
+          if (lo >= 2) {
+            orientations += E[2];
+          } else {
+            orientations += ge[2] * E[2];
+          }
+        }
+        A += lo >= 2 ? Mat3(ellipsoid * orientations) : orientations;
+        // Rotational part of A: one warm-started step of Müller et al. 2016 (see extract_rotation),
+        // from the guess q_c q̄_c⁻¹ whose matrix E_c is already at hand.
+        const Mat3& G = w.orientation_terms[c];
+        const Vec3 torque = G.col(0).cross(A.col(0)) + G.col(1).cross(A.col(1)) + G.col(2).cross(A.col(2));
+        const Real denom = std::abs(G.col(0).dot(A.col(0)) + G.col(1).dot(A.col(1)) + G.col(2).dot(A.col(2))) + 1e-12;
+        const Vec3 omega = torque * (Real(0.5) / denom);
+        Quat R = w.orientation_quats[c];
+        Mat3 Rm = G;
+        if (omega.squaredNorm() >= Real(0.25e-24)) {
+          R = unit(Quat(1, omega.x(), omega.y(), omega.z()) * R);
+          Rm = rotation_matrix(R);
+        }
+        for (std::size_t i = 0; i < members; ++i) {
           const std::size_t j = lo + i;
           if (j < 2) continue;
-          displacement[j] += goals[i] - s.x[j];
-          ++hits[j];
+          w.displacement[j] += Rm * rest[i] + centroid - x[j];
         }
-        new_q[c] = (R * q_rest[c]).normalized();
+        w.new_q[c] = R * q_rest[c];
       }
-      for (std::size_t j = 2; j < count; ++j) s.x[j] += p.stiffness * displacement[j] / Real(hits[j]);
+      for (std::size_t j = 2; j < count; ++j) x[j] += (stiffness * w.inverse_hits[j]) * w.displacement[j];
       for (std::size_t c = 1; c < count; ++c) {
-        Quat target = new_q[c];
-        if (target.dot(s.q[c]) < 0) target.coeffs() = -target.coeffs();
-        s.q[c].coeffs() = (1 - p.stiffness) * s.q[c].coeffs() + p.stiffness * target.coeffs();
-        s.q[c].normalize();
+        const Quat& target = w.new_q[c];
+        // Blend towards the (sign-aligned) target; the normalisation absorbs |target| != 1.
+        const Real sign = target.dot(q[c]) < 0 ? -stiffness : stiffness;
+        q[c] = unit(Quat((1 - stiffness) * q[c].coeffs() + sign * target.coeffs()));
       }
       // Inextensibility: PBD distance constraints, root (kinematic) to tip.
-      for (std::size_t k = 0; k < n; ++k) project_distance(s.x[k + 1], s.x[k + 2], k == 0 ? 0 : 1, 1, lengths[k]);
+      project_distance(x[1], x[2], 0, 1, w.lengths[0]);
+      for (std::size_t k = 1; k < n; ++k) project_distance(x[k + 1], x[k + 2], 1, 1, w.lengths[k]);
       if (!colliders.empty()) {
-        for (std::size_t j = 2; j < count; ++j) push_out_of_colliders(s.x[j], colliders, p.radius);
+        for (std::size_t j = 2; j < count; ++j) push_out_of_colliders(x[j], colliders, p.radius);
       }
     }
     // Exact lengths from the root; a joint pushed out of a collider is re-pulled onto
     // its bone length, a few times, so both hold on output.
     for (std::size_t k = 0; k < n; ++k) {
-      Vec3& a = s.x[k + 1];
-      Vec3& b = s.x[k + 2];
+      Vec3& a = x[k + 1];
+      Vec3& b = x[k + 2];
       for (int pass = 0; pass < 4; ++pass) {
         const Vec3 d = b - a;
         const Real len = d.norm();
-        b = len > 1e-12 ? Vec3(a + d * (lengths[k] / len)) : Vec3(a + s.q[k + 1] * (lengths[k] * rod.geometry.segment_axis(k)));
+        b = len > 1e-12 ? Vec3(a + d * (w.lengths[k] / len))
+                        : Vec3(a + q[k + 1] * (w.lengths[k] * rod.geometry.segment_axis(k)));
         if (colliders.empty() || !push_out_of_colliders(b, colliders, p.radius)) break;
       }
     }
-    for (std::size_t j = 2; j < count; ++j) s.v[j] = (s.x[j] - s.prev_x[j]) / dt;
-    for (std::size_t j = 1; j < count; ++j) s.omega[j] = angular_velocity(s.prev_q[j], s.q[j], dt);
+    for (std::size_t j = 2; j < count; ++j) s.v[j] = (x[j] - s.prev_x[j]) * inverse_dt;
+    for (std::size_t j = 1; j < count; ++j) s.omega[j] = angular_velocity(s.prev_q[j], q[j], dt);
   }
   s.anchor_position = anchor_end;
   s.anchor_rotation = anchor_end_rotation;
@@ -424,7 +541,7 @@ void RodSystem::write_output(std::size_t r, float* rotations_out) {
   const RodDefinition& rod = rods_[r];
   RodState& s = states_[r];
   const std::size_t n = rod.bones.size();
-  QuatList frames;
+  thread_local QuatList frames;
   bone_frames(rod.geometry, s, frames);
   for (std::size_t k = 0; k < n; ++k) {
     const Quat parent = k == 0 ? s.anchor_rotation : Quat(frames[k - 1] * rod.geometry.rest_rotations[k]);
@@ -442,7 +559,7 @@ void RodSystem::write_output(std::size_t r, float* rotations_out) {
 
 void RodSystem::reset(const FrameInput& input, float* rotations_out) {
   const std::vector<Collider> colliders = world_colliders(input);
-  parallel_for(rods_.size(), threads_, 16, [&](std::size_t begin, std::size_t end) {
+  parallel_for_dynamic(rods_.size(), threads_, kRodsPerChunk, [&](std::size_t begin, std::size_t end) {
     for (std::size_t r = begin; r < end; ++r) {
       begin_frame(r, input, colliders, true);
       if (rotations_out) write_output(r, rotations_out);
@@ -452,7 +569,7 @@ void RodSystem::reset(const FrameInput& input, float* rotations_out) {
 
 void RodSystem::step(const FrameInput& input, float* rotations_out) {
   const std::vector<Collider> colliders = world_colliders(input);
-  parallel_for(rods_.size(), threads_, 16, [&](std::size_t begin, std::size_t end) {
+  parallel_for_dynamic(rods_.size(), threads_, kRodsPerChunk, [&](std::size_t begin, std::size_t end) {
     for (std::size_t r = begin; r < end; ++r) {
       const bool fresh = !states_[r].initialised;
       begin_frame(r, input, colliders, fresh);
@@ -476,57 +593,110 @@ Vec3List RodSystem::joint_velocities(std::size_t r) const {
 
 namespace {
 
+// Writes into a buffer sized by state_size() (no growth checks: a frame's snapshot is
+// a few megabytes at 16k bones).
 struct Writer {
-  std::vector<Real>& out;
-  void put(Real v) { out.push_back(v); }
-  void put(const Vec3& v) { out.insert(out.end(), {v.x(), v.y(), v.z()}); }
-  void put(const Quat& q) { out.insert(out.end(), {q.w(), q.x(), q.y(), q.z()}); }
+  Real* out;
+  void put(Real v) { *out++ = v; }
+  void put(const Vec3& v) { out[0] = v.x(); out[1] = v.y(); out[2] = v.z(); out += 3; }
+  void put(const Quat& q) { out[0] = q.w(); out[1] = q.x(); out[2] = q.y(); out[3] = q.z(); out += 4; }
 };
 
 struct Reader {
-  const std::vector<Real>& in;
-  std::size_t at = 0;
-  Real real() { return in.at(at++); }
-  Vec3 vec() { const Vec3 v(in.at(at), in.at(at + 1), in.at(at + 2)); at += 3; return v; }
-  Quat quat() { const Quat q(in.at(at), in.at(at + 1), in.at(at + 2), in.at(at + 3)); at += 4; return q; }
+  const Real* in;
+  Real real() { return *in++; }
+  Vec3 vec() { const Vec3 v(in[0], in[1], in[2]); in += 3; return v; }
+  Quat quat() { const Quat q(in[0], in[1], in[2], in[3]); in += 4; return q; }
 };
 
 }  // namespace
 
+std::size_t RodSystem::rod_state_size(std::size_t r) const {
+  const std::size_t n = rods_[r].bones.size();
+  return 1 + (n + 2) * (3 + 3 + 4 + 3) + n * 4 + 3 + 4 + 3 + 2 + weights_[r].size();
+}
+
 std::size_t RodSystem::state_size() const {
   std::size_t size = 0;
-  for (std::size_t r = 0; r < rods_.size(); ++r) {
-    const std::size_t n = rods_[r].bones.size();
-    size += 1 + (n + 2) * (3 + 3 + 4 + 3) + n * 8 + 3 + 4 + 3 + 2 + weights_[r].size();
-  }
+  for (std::size_t r = 0; r < rods_.size(); ++r) size += rod_state_size(r);
   return size;
 }
 
-std::vector<Real> RodSystem::save_state() const {
-  std::vector<Real> out;
-  out.reserve(state_size());
+void RodSystem::write_rod_state(std::size_t r, Real* out) const {
   Writer w{out};
-  for (std::size_t r = 0; r < rods_.size(); ++r) {
-    const RodState& s = states_[r];
-    const std::size_t n = rods_[r].bones.size();
-    w.put(s.initialised ? 1.0 : 0.0);
-    for (std::size_t j = 0; j < n + 2; ++j) {
-      w.put(s.initialised ? s.x[j] : Vec3::Zero());
-      w.put(s.initialised ? s.v[j] : Vec3::Zero());
-      w.put(s.initialised ? s.q[j] : Quat::Identity());
-      w.put(s.initialised ? s.omega[j] : Vec3::Zero());
-    }
-    for (std::size_t k = 0; k < n; ++k) {
-      w.put(s.initialised ? s.rest_local[k] : Quat::Identity());
-      w.put(s.initialised ? s.last_output[k] : Quat::Identity());
-    }
-    w.put(s.anchor_position);
-    w.put(s.anchor_rotation);
-    w.put(s.reference_position);
-    w.put(s.time_accumulator);
-    w.put(s.speed);
-    for (Real v : weights_[r]) w.put(v);
+  const RodState& s = states_[r];
+  const std::size_t n = rods_[r].bones.size();
+  w.put(s.initialised ? 1.0 : 0.0);
+  for (std::size_t j = 0; j < n + 2; ++j) {
+    w.put(s.initialised ? s.x[j] : Vec3::Zero());
+    w.put(s.initialised ? s.v[j] : Vec3::Zero());
+    w.put(s.initialised ? s.q[j] : Quat::Identity());
+    w.put(s.initialised ? s.omega[j] : Vec3::Zero());
   }
+  for (std::size_t k = 0; k < n; ++k) w.put(s.initialised ? s.last_output[k] : Quat::Identity());
+  w.put(s.anchor_position);
+  w.put(s.anchor_rotation);
+  w.put(s.reference_position);
+  w.put(s.time_accumulator);
+  w.put(s.speed);
+  for (Real v : weights_[r]) w.put(v);
+}
+
+void RodSystem::read_rod_state(std::size_t r, const Real* in) {
+  Reader rd{in};
+  RodState& s = states_[r];
+  const std::size_t n = rods_[r].bones.size();
+  s.initialised = rd.real() != 0;
+  s.x.resize(n + 2);
+  s.v.resize(n + 2);
+  s.q.resize(n + 2);
+  s.omega.resize(n + 2);
+  s.prev_x.resize(n + 2);
+  s.prev_q.resize(n + 2);
+  s.rest_local.assign(n, Quat::Identity());
+  s.last_output.resize(n);
+  for (std::size_t j = 0; j < n + 2; ++j) {
+    s.x[j] = rd.vec();
+    s.v[j] = rd.vec();
+    s.q[j] = rd.quat();
+    s.omega[j] = rd.vec();
+  }
+  for (std::size_t k = 0; k < n; ++k) s.last_output[k] = rd.quat();
+  s.anchor_position = rd.vec();
+  s.anchor_rotation = rd.quat();
+  s.reference_position = rd.vec();
+  s.time_accumulator = rd.real();
+  s.speed = rd.real();
+  for (Real& v : weights_[r]) v = rd.real();
+  // The rest shape is not stored: it is always the blend of the keys with these weights
+  // (begin_frame), recomputed here bit for bit by the same function.
+  if (s.initialised) {
+    std::vector<const QuatList*> shapes;
+    for (const RodKey& key : rods_[r].keys) shapes.push_back(&key.shape);
+    blend_shapes_into(shapes.data(), shapes.size(), weights_[r].data(), n, s.rest_local);
+  }
+}
+
+void RodSystem::write_state(Real* out) const {
+  // Rod by rod in parallel: at 16k bones a snapshot is megabytes of fresh memory, and
+  // touching it from every thread halves the page-fault time.
+  std::vector<std::size_t> offsets(rods_.size() + 1, 0);
+  for (std::size_t r = 0; r < rods_.size(); ++r) offsets[r + 1] = offsets[r] + rod_state_size(r);
+  parallel_for_dynamic(rods_.size(), threads_, 4 * kRodsPerChunk, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t r = begin; r < end; ++r) write_rod_state(r, out + offsets[r]);
+  });
+}
+
+void RodSystem::read_state(const Real* in) {
+  for (std::size_t r = 0; r < rods_.size(); ++r) {
+    read_rod_state(r, in);
+    in += rod_state_size(r);
+  }
+}
+
+std::vector<Real> RodSystem::save_state() const {
+  std::vector<Real> out(state_size());
+  write_state(out.data());
   return out;
 }
 
@@ -535,36 +705,45 @@ void RodSystem::load_state(const std::vector<Real>& state) {
     throw std::invalid_argument("state has " + std::to_string(state.size()) + " values, this system needs " +
                                 std::to_string(state_size()));
   }
-  Reader rd{state};
-  for (std::size_t r = 0; r < rods_.size(); ++r) {
-    RodState& s = states_[r];
-    const std::size_t n = rods_[r].bones.size();
-    s.initialised = rd.real() != 0;
-    s.x.resize(n + 2);
-    s.v.resize(n + 2);
-    s.q.resize(n + 2);
-    s.omega.resize(n + 2);
-    s.prev_x.resize(n + 2);
-    s.prev_q.resize(n + 2);
-    s.rest_local.resize(n);
-    s.last_output.resize(n);
-    for (std::size_t j = 0; j < n + 2; ++j) {
-      s.x[j] = rd.vec();
-      s.v[j] = rd.vec();
-      s.q[j] = rd.quat();
-      s.omega[j] = rd.vec();
+  read_state(state.data());
+}
+
+std::size_t RodSystem::rod_bone_count() const {
+  std::size_t count = 0;
+  for (const RodDefinition& rod : rods_) count += rod.bones.size();
+  return count;
+}
+
+void RodSystem::store_frame(int frame, const float* rotations) {
+  FrameCache::Entry entry;
+  entry.state_size = state_size();
+  entry.state.reset(new Real[entry.state_size]);  // not zeroed: write_state fills every value
+  write_state(entry.state.get());
+  entry.rotations.resize(4 * rod_bone_count());
+  float* out = entry.rotations.data();
+  for (const RodDefinition& rod : rods_) {
+    for (int bone : rod.bones) {
+      std::copy_n(rotations + 4 * static_cast<std::size_t>(bone), 4, out);
+      out += 4;
     }
-    for (std::size_t k = 0; k < n; ++k) {
-      s.rest_local[k] = rd.quat();
-      s.last_output[k] = rd.quat();
-    }
-    s.anchor_position = rd.vec();
-    s.anchor_rotation = rd.quat();
-    s.reference_position = rd.vec();
-    s.time_accumulator = rd.real();
-    s.speed = rd.real();
-    for (Real& v : weights_[r]) v = rd.real();
   }
+  cache_.store(frame, std::move(entry));
+}
+
+bool RodSystem::recall_frame(int frame, float* rotations_out, bool load) {
+  const FrameCache::Entry* entry = cache_.find(frame);
+  if (entry == nullptr) return false;
+  if (load) read_state(entry->state.get());
+  if (rotations_out != nullptr) {
+    const float* in = entry->rotations.data();
+    for (const RodDefinition& rod : rods_) {
+      for (int bone : rod.bones) {
+        std::copy_n(in, 4, rotations_out + 4 * static_cast<std::size_t>(bone));
+        in += 4;
+      }
+    }
+  }
+  return true;
 }
 
 }  // namespace kodawari::rod

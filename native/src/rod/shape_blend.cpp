@@ -7,19 +7,28 @@ namespace kodawari::rod {
 QuatList blend_shapes(const std::vector<QuatList>& key_shapes, const std::vector<Real>& weights,
                       std::size_t bone_count) {
   if (weights.size() != key_shapes.size() + 1) throw std::invalid_argument("need one weight per key plus the base");
-  QuatList out(bone_count);
+  std::vector<const QuatList*> shapes;
+  shapes.reserve(key_shapes.size());
+  for (const QuatList& shape : key_shapes) shapes.push_back(&shape);
+  QuatList out;
+  blend_shapes_into(shapes.data(), shapes.size(), weights.data(), bone_count, out);
+  return out;
+}
+
+void blend_shapes_into(const QuatList* const* key_shapes, std::size_t key_count, const Real* weights,
+                       std::size_t bone_count, QuatList& out) {
+  out.resize(bone_count);
   for (std::size_t k = 0; k < bone_count; ++k) {
     // Base shape: the identity (the bones' rest pose), weight w[0].
     Eigen::Matrix<Real, 4, 1> sum(weights[0], 0, 0, 0);  // (w, x, y, z)
-    for (std::size_t i = 0; i < key_shapes.size(); ++i) {
-      const Quat& q = key_shapes[i][k];
+    for (std::size_t i = 0; i < key_count; ++i) {
+      const Quat& q = (*key_shapes[i])[k];
       const Real sign = q.w() < 0 ? Real(-1) : Real(1);
       sum += weights[i + 1] * sign * Eigen::Matrix<Real, 4, 1>(q.w(), q.x(), q.y(), q.z());
     }
     const Real norm = sum.norm();
     out[k] = norm > 1e-12 ? Quat(sum[0] / norm, sum[1] / norm, sum[2] / norm, sum[3] / norm) : Quat::Identity();
   }
-  return out;
 }
 
 void chain_forward_kinematics(const ChainGeometry& geometry, const QuatList& local_rotations, QuatList& frames,

@@ -13,16 +13,18 @@ namespace kodawari::rod {
 // from `guess`. Deterministic: a fixed iteration cap and a fixed tolerance.
 Quat extract_rotation(const Mat3& A, const Quat& guess, int max_iterations = 24);
 
-// One shape-matching group: members' current positions x, rest positions x_rest,
-// orientation terms E_i = R(q_i) R(q̄_i)^T (current times rest orientation, transposed;
-// computed once per particle and shared by its groups), weights w (mass). Computes
-//   A = sum w_i (x_i - c)(x̄_i - c̄)^T + sum w_i e E_i    (ellipsoid term, e = a²/5)
-// R = polar(A) and the goals g_i = R (x̄_i - c̄) + c. Returns R.
-Quat match_group(const Vec3* x, const Vec3* x_rest, const Mat3* orientation_terms, const Real* w, int count,
-                 Real ellipsoid, const Quat& guess, Vec3* goals);
-
-// PBD distance constraint between a and b with inverse masses wa, wb.
-void project_distance(Vec3& a, Vec3& b, Real wa, Real wb, Real rest_length);
+// PBD distance constraint between a and b with inverse masses wa, wb (inline: the
+// substep loop calls it once per segment).
+inline void project_distance(Vec3& a, Vec3& b, Real wa, Real wb, Real rest_length) {
+  const Real wsum = wa + wb;
+  if (wsum <= 0) return;
+  const Vec3 d = b - a;
+  const Real len = d.norm();
+  if (len < 1e-12) return;
+  const Vec3 correction = (len - rest_length) / (len * wsum) * d;
+  a += wa * correction;
+  b -= wb * correction;
+}
 
 struct Collider {
   Vec3 start;         // sphere centre, or capsule axis start

@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "kodawari/common.hpp"
+#include "kodawari/rod/frame_cache.hpp"
 #include "kodawari/rod/oriented_particles.hpp"
 #include "kodawari/rod/shape_blend.hpp"
 
@@ -121,10 +122,25 @@ class RodSystem {
   void load_state(const std::vector<Real>& state);
   std::size_t state_size() const;
 
+  // Exact per-frame cache: store_frame() snapshots the state and the rod bones' rows of
+  // `rotations` (B x 4, as written by step/reset); recall_frame() loads a frame's state
+  // (when load_state is true) and writes its rod-bone rows into rotations_out (if not null).
+  void store_frame(int frame, const float* rotations);
+  bool recall_frame(int frame, float* rotations_out, bool load_state);
+  FrameCache& frame_cache() { return cache_; }
+  const FrameCache& frame_cache() const { return cache_; }
+  // Number of rod bones (rows of a cached frame's rotations).
+  std::size_t rod_bone_count() const;
+
  private:
   void begin_frame(std::size_t r, const FrameInput& input, const std::vector<Collider>& colliders, bool reset);
   void simulate(std::size_t r, const FrameInput& input, const std::vector<Collider>& colliders);
   void write_output(std::size_t r, float* rotations_out);
+  std::size_t rod_state_size(std::size_t r) const;
+  void write_rod_state(std::size_t r, Real* out) const;
+  void read_rod_state(std::size_t r, const Real* in);
+  void write_state(Real* out) const;  // state_size() values
+  void read_state(const Real* in);
   std::vector<Collider> world_colliders(const FrameInput& input) const;
 
   std::size_t bone_count_;
@@ -133,6 +149,7 @@ class RodSystem {
   std::vector<RodState> states_;
   std::vector<std::vector<Real>> weights_;
   std::vector<ColliderDefinition> colliders_;
+  FrameCache cache_;
 };
 
 // Matrix of pose bone `index` from the foreach_get buffer, with rotation and position.

@@ -32,6 +32,9 @@ struct ChainGeometry {
 // shapes[i] is one shape (bone_count rotations); the base shape is the identity.
 QuatList blend_shapes(const std::vector<QuatList>& key_shapes, const std::vector<Real>& weights,
                       std::size_t bone_count);
+// The same blend without copies: key_shapes[i] points at key i's shape; writes `out`.
+void blend_shapes_into(const QuatList* const* key_shapes, std::size_t key_count, const Real* weights,
+                       std::size_t bone_count, QuatList& out);
 
 // Forward kinematics in the anchor frame (the root bone's rest frame under its parent):
 // bone frames and head positions, plus the tip position as heads[n].
