@@ -170,6 +170,8 @@ def test_auto_head_axis_guesses_reports_and_flips(empty_scene):
     settings = add_swim(obj, head_axis="AUTO")
     assert settings.head_axis == "NEG_Y"
     assert "-Y" in settings.head_guess
+    # The live handler writes the shape key on frame changes, so renders must lock the interface.
+    assert empty_scene.render.use_lock_interface
     assert bpy.ops.kodawari.swim_flip_head() == {"FINISHED"}
     assert settings.head_axis == "POS_Y"
 

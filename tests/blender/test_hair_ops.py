@@ -36,6 +36,8 @@ def test_rod_add_makes_a_rod_per_selected_chain_with_the_named_settings(empty_sc
     assert {"rods", "enabled", "colliders"} <= set(settings.bl_rna.properties.keys())
     assert ROD_FIELDS <= set(settings.rods[0].bl_rna.properties.keys())
     assert all(pb.rotation_mode == "QUATERNION" for pb in chain_bones(obj, "Ahoge"))
+    # The live handler writes pose bones on frame changes, so renders must lock the interface.
+    assert empty_scene.render.use_lock_interface
     # Adding the same chain again is refused.
     assert_refused(obj, lambda: bpy.ops.kodawari.rod_add(), "already belongs")
 

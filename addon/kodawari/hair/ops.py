@@ -151,7 +151,11 @@ class KODAWARI_OT_rod_add(_HairOperator, bpy.types.Operator):
                     pb.rotation_mode = "QUATERNION"
         settings.active_rod = len(settings.rods) - 1
         runtime.invalidate(obj)
-        self.report({"INFO"}, f"Added {len(plans)} rod(s): " + ", ".join(r.name for r, _ in plans))
+        # The live handler writes pose bones on frame changes; renders must wait for it.
+        context.scene.render.use_lock_interface = True
+        names = [r.name for r, _ in plans]
+        shown = ", ".join(names[:8]) + (f" and {len(names) - 8} more" if len(names) > 8 else "")
+        self.report({"INFO"}, f"Added {len(plans)} rod(s): {shown}")
         return {"FINISHED"}
 
 
