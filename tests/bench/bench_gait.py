@@ -58,7 +58,7 @@ def bench_blender_ik(scene, rig, job):
     ours = {f'pose.bones["{n}"].{p}' for n in leg_bones for p in ("rotation_quaternion", "rotation_euler")}
     for curve in list(fcurves.action_fcurves(action, rig)):
         if curve.data_path in ours:
-            action.fcurves.remove(curve)  # Blender 3.4 (the benchmark's Blender) has Action.fcurves
+            fcurves.remove_fcurve(action, rig, curve)
     feet = job.result["feet_planned"][:IK_FRAMES]
     frames = np.arange(1, IK_FRAMES + 1, dtype=np.float64)
     for k, leg in enumerate(settings.legs):
