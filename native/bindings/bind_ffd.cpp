@@ -122,7 +122,7 @@ void bind_ffd(py::module_& m) {
         const Vec3List points = to_control_points(control_points);
         const std::vector<Real> twist_values = to_twist(twist, points.size());
         const std::optional<Vec3> up_hint = to_up(up);
-        if (samples < 2) throw py::value_error("samples must be >= 2");
+        if (samples < 2 || samples > 100000) throw py::value_error("samples must be 2..100000");
         const ffd::FrameList frames = ffd::axis_frames(points, twist_values, up_hint, samples);
         py::array_t<double> out({static_cast<py::ssize_t>(samples), py::ssize_t(4), py::ssize_t(3)});
         double* data = out.mutable_data();

@@ -4,6 +4,7 @@
 #include <pybind11/stl.h>
 
 #include <cmath>
+#include <stdexcept>
 #include <string>
 
 #include "arrays.hpp"
@@ -61,8 +62,13 @@ void bind_swim(py::module_& m) {
         if (wavelength <= 0) throw py::value_error("wavelength must be positive");
         swim::BodyWave wave{wavelength, amplitude, amplitude_head, envelope_start, envelope_power, phase_offset,
                             preserve_length};
-        return finite_points(swim::body_axis(to_points(rest, "rest_points"), bend, body_length, wave, phase),
-                             "amplitude, amplitude_head, envelope_start and envelope_power");
+        Vec3List axis;
+        try {
+          axis = swim::body_axis(to_points(rest, "rest_points"), bend, body_length, wave, phase);
+        } catch (const std::invalid_argument& e) {  // the core names its own terms: say which argument
+          throw py::value_error(std::string("rest_points: ") + e.what());
+        }
+        return finite_points(axis, "amplitude, amplitude_head, envelope_start and envelope_power");
       },
       py::arg("rest_points"), py::arg("bend_direction"), py::arg("body_length"), py::arg("phase"),
       py::arg("wavelength") = 1.0, py::arg("amplitude") = 0.1, py::arg("amplitude_head") = 0.0,
@@ -105,7 +111,12 @@ void bind_swim(py::module_& m) {
         if (wavelength <= 0) throw py::value_error("wavelength must be positive");
         swim::FinWave wave{fin_motion_from(motion), amplitude, feathering, feather_on_power, wavelength,
                            fixed_count};
-        const swim::FinPose pose = swim::fin_axis(to_points(rest, "rest_points"), frame, wave, phase);
+        swim::FinPose pose;
+        try {
+          pose = swim::fin_axis(to_points(rest, "rest_points"), frame, wave, phase);
+        } catch (const std::invalid_argument& e) {
+          throw py::value_error(std::string("rest_points: ") + e.what());
+        }
         require_finite_result(pose.twist.data(), pose.twist.size(), "amplitude and feathering give a non-finite twist");
         return py::make_tuple(finite_points(pose.points, "amplitude, feathering and fixed_count"), to_array(pose.twist));
       },

@@ -7,15 +7,14 @@ import subprocess
 import sys
 import textwrap
 
+import kodawari_native as kn
 import numpy as np
 import pytest
 
-import kodawari_native as kn
-
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
-from gait_rigs import horse_rig  # noqa: E402
-from rod_chain import Chain  # noqa: E402
+from gait_rigs import horse_rig
+from rod_chain import Chain
 
 AXIS = np.column_stack([np.linspace(0.0, 4.0, 5), np.zeros(5), np.zeros(5)])
 
@@ -24,8 +23,15 @@ def run_isolated(code, timeout=120):
     """Runs `code` in a fresh interpreter with this module's import path; returns
     (exit code, stdout + stderr). A negative exit code is a signal (-11 segfault)."""
     env = dict(os.environ, PYTHONPATH=os.pathsep.join([os.path.dirname(kn.__file__), HERE]))
-    proc = subprocess.run([sys.executable, "-c", textwrap.dedent(code)], capture_output=True, text=True,
-                          timeout=timeout, env=env, cwd=HERE)
+    proc = subprocess.run(
+        [sys.executable, "-c", textwrap.dedent(code)],
+        check=False,
+        capture_output=True,
+        text=True,
+        timeout=timeout,
+        env=env,
+        cwd=HERE,
+    )
     return proc.returncode, proc.stdout + proc.stderr
 
 
@@ -36,15 +42,25 @@ def ground(**changes):
 
 
 def gait_bake(speed=1.0, ground=None, frames=24):
-    return kn.gait_bake(horse_rig(), kn.gait_horse_table(), np.full(frames, speed), np.full(frames, -1.0),
-                        24.0, 3.0, 10, None, ground)
+    return kn.gait_bake(
+        horse_rig(),
+        kn.gait_horse_table(),
+        np.full(frames, speed),
+        np.full(frames, -1.0),
+        24.0,
+        3.0,
+        10,
+        None,
+        ground,
+    )
 
 
 # ---------------------------------------------------------------- item 1: heightfield
 
 
-@pytest.mark.parametrize("key,value", [("x0", np.nan), ("y0", np.nan), ("x0", np.inf), ("y0", -np.inf),
-                                       ("cell", np.inf)])
+@pytest.mark.parametrize(
+    "key,value", [("x0", np.nan), ("y0", np.nan), ("x0", np.inf), ("y0", -np.inf), ("cell", np.inf)]
+)
 def test_gait_bake_refuses_a_non_finite_ground_grid_naming_the_key(key, value):
     code, out = run_isolated(f"""
         import numpy as np
@@ -133,8 +149,15 @@ def test_rod_armature_scale_out_of_range_is_refused(scale):
     chain = Chain()
     chain.reset()
     with pytest.raises(ValueError, match="armature_matrix"):
-        chain.system.step(chain.matrices(), np.diag([scale, scale, scale, 1.0]), None, np.zeros(3), 0.1, 1 / 24,
-                          chain.out)
+        chain.system.step(
+            chain.matrices(),
+            np.diag([scale, scale, scale, 1.0]),
+            None,
+            np.zeros(3),
+            0.1,
+            1 / 24,
+            chain.out,
+        )
     assert np.isfinite(chain.positions()).all()
 
 
@@ -163,7 +186,9 @@ def test_wrong_types_in_the_ground_dict_name_the_key(key, value):
         gait_bake(ground=ground(**{key: value}))
 
 
-@pytest.mark.parametrize("key,value", [("use_froude", "yes"), ("hysteresis", "0.1"), ("reach", [0.5])])
+@pytest.mark.parametrize(
+    "key,value", [("use_froude", "yes"), ("hysteresis", "0.1"), ("reach", [0.5])]
+)
 def test_wrong_types_in_the_table_dict_name_the_key(key, value):
     table = kn.gait_horse_table()
     table[key] = value
