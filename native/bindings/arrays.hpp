@@ -5,7 +5,8 @@
 //             no_overlap: an output must not share memory with an input
 //   numbers   finite_number: finite and within ±kMaxMagnitude
 //   dicts     dict_arg / item / number_item / int_item / bool_item / sequence_item
-//   vectors   vec3, unit_vector, to_points (NumPy -> core), points_array, to_array (core -> NumPy)
+//   vectors   NumPy -> core: vec3, unit_vector, to_points, to_quats, to_vector;
+//             core -> NumPy: vec3_array, points_array, quats_array, to_array
 //   results   require_finite_result: a non-finite result is a ValueError, never returned
 //   threads   ExclusiveUse: refuses a second thread on an object whose methods release the GIL
 #pragma once
@@ -199,13 +200,49 @@ inline Vec3 unit_vector(const py::handle& obj, const std::string& name) {
   return v.normalized();
 }
 
-// float64 (N, 3) -> points.
-inline Vec3List to_points(const py::handle& obj, const std::string& name) {
-  const auto a = checked_array<double>(obj, name, -1, 3);
+// float64 (rows, 3) -> points (rows < 0: any count).
+inline Vec3List to_points(const py::handle& obj, const std::string& name, py::ssize_t rows = -1) {
+  const auto a = checked_array<double>(obj, name, rows, 3);
   const double* d = a.data();
   Vec3List points(static_cast<std::size_t>(a.shape(0)));
   for (std::size_t i = 0; i < points.size(); ++i) points[i] = Vec3(d[3 * i], d[3 * i + 1], d[3 * i + 2]);
   return points;
+}
+
+// float64 (rows, 4) (w, x, y, z) -> quaternions, as written (not normalised).
+inline QuatList to_quats(const py::handle& obj, const std::string& name, py::ssize_t rows = -1) {
+  const auto a = checked_array<double>(obj, name, rows, 4);
+  const double* d = a.data();
+  QuatList quats;
+  quats.reserve(static_cast<std::size_t>(a.shape(0)));
+  for (py::ssize_t i = 0; i < a.shape(0); ++i) quats.emplace_back(d[4 * i], d[4 * i + 1], d[4 * i + 2], d[4 * i + 3]);
+  return quats;
+}
+
+// float64 (rows,) -> values (rows < 0: any count).
+inline std::vector<Real> to_vector(const py::handle& obj, const std::string& name, py::ssize_t rows = -1) {
+  const auto a = checked_array<double>(obj, name, rows, 0);
+  return std::vector<Real>(a.data(), a.data() + a.shape(0));
+}
+
+// v -> float64 (3,).
+inline py::array_t<double> vec3_array(const Vec3& v) {
+  py::array_t<double> out(3);
+  for (int c = 0; c < 3; ++c) out.mutable_data()[c] = v[c];
+  return out;
+}
+
+// quaternions -> float64 (N, 4) (w, x, y, z).
+inline py::array_t<double> quats_array(const QuatList& quats) {
+  py::array_t<double> out({static_cast<py::ssize_t>(quats.size()), py::ssize_t(4)});
+  double* d = out.mutable_data();
+  for (std::size_t i = 0; i < quats.size(); ++i) {
+    d[4 * i] = quats[i].w();
+    d[4 * i + 1] = quats[i].x();
+    d[4 * i + 2] = quats[i].y();
+    d[4 * i + 3] = quats[i].z();
+  }
+  return out;
 }
 
 // points -> float64 (N, 3).

@@ -30,8 +30,7 @@ Vec3List to_control_points(const py::handle& obj) {
 
 std::vector<Real> to_twist(const py::handle& obj, std::size_t count) {
   if (obj.is_none()) return {};
-  const auto arr = checked_array<double>(obj, "twist", static_cast<py::ssize_t>(count), 0);
-  return std::vector<Real>(arr.data(), arr.data() + count);
+  return to_vector(obj, "twist", static_cast<py::ssize_t>(count));
 }
 
 std::optional<Vec3> to_up(const py::handle& obj) {
@@ -162,8 +161,7 @@ void bind_ffd(py::module_& m) {
       "preserve_lengths",
       [](const py::handle& points, const py::handle& rest_lengths, long moved_index, std::optional<double> arc_length) {
         const Vec3List p = to_points(points, "points");
-        const auto rest = checked_array<double>(rest_lengths, "rest_lengths", -1, 0);
-        const std::vector<Real> lengths(rest.data(), rest.data() + rest.shape(0));
+        const std::vector<Real> lengths = to_vector(rest_lengths, "rest_lengths");
         return points_array(ffd::preserve_lengths(p, lengths, moved_index, arc_length));
       },
       py::arg("points"), py::arg("rest_lengths"), py::arg("moved_index"), py::arg("arc_length") = py::none(),
@@ -174,8 +172,7 @@ void bind_ffd(py::module_& m) {
       "preserve_lengths_from_head",
       [](const py::handle& points, const py::handle& rest_lengths, std::optional<double> arc_length) {
         const Vec3List p = to_points(points, "points");
-        const auto rest = checked_array<double>(rest_lengths, "rest_lengths", -1, 0);
-        const std::vector<Real> lengths(rest.data(), rest.data() + rest.shape(0));
+        const std::vector<Real> lengths = to_vector(rest_lengths, "rest_lengths");
         return points_array(ffd::preserve_lengths_from_head(p, lengths, arc_length));
       },
       py::arg("points"), py::arg("rest_lengths"), py::arg("arc_length") = py::none(),

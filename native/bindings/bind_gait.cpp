@@ -78,17 +78,13 @@ Rig rig_from(const py::handle& rig_arg) {
   for (int leg = 0; leg < kLegCount; ++leg) {
     const std::string where = "rig['legs'][" + std::to_string(leg) + "]";
     const py::dict l = dict_arg(legs[leg], where);
-    auto heads = checked_array<double>(item(l, "heads", where), where + "['heads']", -1, 3);
-    const py::ssize_t n = heads.shape(0);
     LegRig& out = rig.legs[leg];
-    for (py::ssize_t k = 0; k < n; ++k) out.heads.emplace_back(heads.at(k, 0), heads.at(k, 1), heads.at(k, 2));
+    out.heads = to_points(item(l, "heads", where), where + "['heads']");
+    const auto n = static_cast<py::ssize_t>(out.heads.size());
     out.tail = vec3(item(l, "tail", where), where + "['tail']");
-    auto lo = checked_array<double>(item(l, "limit_min", where), where + "['limit_min']", n, 0);
-    auto hi = checked_array<double>(item(l, "limit_max", where), where + "['limit_max']", n, 0);
-    auto st = checked_array<double>(item(l, "stiffness", where), where + "['stiffness']", n, 0);
-    out.limit_min.assign(lo.data(), lo.data() + n);
-    out.limit_max.assign(hi.data(), hi.data() + n);
-    out.stiffness.assign(st.data(), st.data() + n);
+    out.limit_min = to_vector(item(l, "limit_min", where), where + "['limit_min']", n);
+    out.limit_max = to_vector(item(l, "limit_max", where), where + "['limit_max']", n);
+    out.stiffness = to_vector(item(l, "stiffness", where), where + "['stiffness']", n);
   }
   const std::string why = validate_rig(rig);
   if (!why.empty()) throw py::value_error(why);
@@ -218,9 +214,8 @@ void bind_gait(py::module_& m) {
         in.acceleration = acceleration;
         in.ccd_iterations = ccd_iterations;
         if (!path.is_none()) {
-          auto p = checked_array<double>(path, "path", -1, 3);
-          if (p.shape(0) < 2) throw py::value_error("path needs at least 2 points");
-          for (py::ssize_t i = 0; i < p.shape(0); ++i) in.path.emplace_back(p.at(i, 0), p.at(i, 1), p.at(i, 2));
+          in.path = to_points(path, "path");
+          if (in.path.size() < 2) throw py::value_error("path needs at least 2 points");
         }
         if (!ground.is_none()) {
           const py::dict g = dict_arg(ground, "ground");

@@ -71,26 +71,19 @@ std::size_t add_rod(RodSystem& system, int parent_bone, int reference_bone, cons
   auto b = checked_array<std::int32_t>(bones, "bones", -1, 0);
   const py::ssize_t n = b.shape(0);
   if (n == 0) throw py::value_error("bones is empty: a rod needs at least one joint");
-  auto off = checked_array<double>(offsets, "offsets", n + 1, 3);
-  auto rot = checked_array<double>(rest_rotations, "rest_rotations", n, 4);
   auto cond = checked_array<std::int32_t>(key_conditions, "key_conditions", -1, 0);
   const py::ssize_t m = cond.shape(0);
-  auto dirs = checked_array<double>(key_directions, "key_directions", m, 3);
-  auto krot = checked_array<double>(key_rotations, "key_rotations", m, 4);
-  auto speeds = checked_array<double>(key_speeds, "key_speeds", m, 0);
-  auto infl = checked_array<double>(key_influences, "key_influences", m, 0);
-  auto shapes = checked_array<double>(key_shapes, "key_shapes", m * n, 4);
+  const Vec3List dirs = to_points(key_directions, "key_directions", m);
+  const QuatList krot = to_quats(key_rotations, "key_rotations", m);
+  const std::vector<Real> speeds = to_vector(key_speeds, "key_speeds", m);
+  const std::vector<Real> infl = to_vector(key_influences, "key_influences", m);
+  const QuatList shapes = to_quats(key_shapes, "key_shapes", m * n);
   RodDefinition rod;
   rod.parent_bone = parent_bone;
   rod.reference_bone = reference_bone;
   rod.bones.assign(b.data(), b.data() + n);
-  for (py::ssize_t i = 0; i <= n; ++i) {
-    rod.geometry.offsets.emplace_back(off.data()[3 * i], off.data()[3 * i + 1], off.data()[3 * i + 2]);
-  }
-  for (py::ssize_t i = 0; i < n; ++i) {
-    const double* q = rot.data() + 4 * i;
-    rod.geometry.rest_rotations.emplace_back(q[0], q[1], q[2], q[3]);
-  }
+  rod.geometry.offsets = to_points(offsets, "offsets", n + 1);
+  rod.geometry.rest_rotations = to_quats(rest_rotations, "rest_rotations", n);
   for (auto [v, name] : {std::pair{stiffness, "stiffness"}, {damping, "damping"}, {gravity, "gravity"}, {radius, "radius"}}) {
     finite_number(v, name);
   }
@@ -107,15 +100,11 @@ std::size_t add_rod(RodSystem& system, int parent_bone, int reference_bone, cons
     const int c = cond.data()[i];
     if (c < 0 || c > 2) throw py::value_error("key_conditions must be 0 (VIEW), 1 (POSE) or 2 (SPEED)");
     key.condition = static_cast<Condition>(c);
-    key.direction = Vec3(dirs.data()[3 * i], dirs.data()[3 * i + 1], dirs.data()[3 * i + 2]);
-    const double* q = krot.data() + 4 * i;
-    key.rotation = Quat(q[0], q[1], q[2], q[3]);
-    key.speed = speeds.data()[i];
-    key.influence = infl.data()[i];
-    for (py::ssize_t k = 0; k < n; ++k) {
-      const double* s = shapes.data() + 4 * (i * n + k);
-      key.shape.emplace_back(s[0], s[1], s[2], s[3]);
-    }
+    key.direction = dirs[i];
+    key.rotation = krot[i];
+    key.speed = speeds[i];
+    key.influence = infl[i];
+    key.shape.assign(shapes.begin() + i * n, shapes.begin() + (i + 1) * n);
     rod.keys.push_back(std::move(key));
   }
   const ExclusiveUse use = exclusive(system);
@@ -132,13 +121,9 @@ void bind_rod(py::module_& m) {
   m.def(
       "view_weights",
       [](const py::handle& key_directions, const py::handle& influences, const py::handle& view) {
-        auto dirs = checked_array<double>(key_directions, "key_directions", -1, 3);
-        const py::ssize_t count = dirs.shape(0);
-        auto infl = checked_array<double>(influences, "influences", count, 0);
+        const Vec3List d = to_points(key_directions, "key_directions");
+        const std::vector<Real> p = to_vector(influences, "influences", static_cast<py::ssize_t>(d.size()));
         const Vec3 v = vec3(view, "view");
-        Vec3List d;
-        std::vector<Real> p(infl.data(), infl.data() + count);
-        for (py::ssize_t i = 0; i < count; ++i) d.emplace_back(dirs.data()[3 * i], dirs.data()[3 * i + 1], dirs.data()[3 * i + 2]);
         try {
           return to_array(view_weights(d, p, v));
         } catch (const std::invalid_argument& e) {
@@ -153,11 +138,10 @@ void bind_rod(py::module_& m) {
   m.def(
       "condition_weights",
       [](const py::handle& similarities, const py::handle& influences) {
-        auto s = checked_array<double>(similarities, "similarities", -1, 0);
-        auto p = checked_array<double>(influences, "influences", s.shape(0), 0);
+        const std::vector<Real> s = to_vector(similarities, "similarities");
+        const std::vector<Real> p = to_vector(influences, "influences", static_cast<py::ssize_t>(s.size()));
         try {
-          return to_array(condition_weights(std::vector<Real>(s.data(), s.data() + s.shape(0)),
-                                            std::vector<Real>(p.data(), p.data() + p.shape(0))));
+          return to_array(condition_weights(s, p));
         } catch (const std::invalid_argument& e) {
           throw py::value_error(e.what());
         }
@@ -192,7 +176,7 @@ void bind_rod(py::module_& m) {
             auto b = checked_array<std::int32_t>(bones, "bones", -1, 0);
             const py::ssize_t c = b.shape(0);
             auto cap = checked_array<std::int32_t>(capsule, "capsule", c, 0);
-            auto off = checked_array<double>(offsets, "offsets", c, 3);
+            const Vec3List off = to_points(offsets, "offsets", c);
             auto rad = checked_array<double>(radii, "radii", c, 0);
             auto len = checked_array<double>(lengths, "lengths", c, 0);
             std::vector<ColliderDefinition> list;
@@ -200,7 +184,7 @@ void bind_rod(py::module_& m) {
               ColliderDefinition d;
               d.bone = b.data()[i];
               d.capsule = cap.data()[i] != 0;
-              d.offset = Vec3(off.data()[3 * i], off.data()[3 * i + 1], off.data()[3 * i + 2]);
+              d.offset = off[i];
               d.radius = rad.data()[i];
               d.length = len.data()[i];
               list.push_back(d);
@@ -280,13 +264,7 @@ void bind_rod(py::module_& m) {
       .def("rest_shape", [](const RodSystem& self, std::size_t rod) {
              const ExclusiveUse use = exclusive(self);
              if (rod >= self.rod_count()) throw py::index_error("rod index out of range");
-             const QuatList& q = self.rest_shape(rod);
-             py::array_t<double> out({static_cast<py::ssize_t>(q.size()), py::ssize_t(4)});
-             double* d = out.mutable_data();
-             for (std::size_t i = 0; i < q.size(); ++i) {
-               d[4 * i] = q[i].w(); d[4 * i + 1] = q[i].x(); d[4 * i + 2] = q[i].y(); d[4 * i + 3] = q[i].z();
-             }
-             return out;
+             return quats_array(self.rest_shape(rod));
            }, py::arg("rod"), "The rest shape blended this frame, (n, 4) rotations.")
       .def("save_state", [](const RodSystem& self) {
              const ExclusiveUse use = exclusive(self);

@@ -130,10 +130,7 @@ void bind_swim(py::module_& m) {
       "swim_flap_stroke_direction",
       [](const py::handle& fin_axis, const py::handle& tangent, const py::handle& side, const py::handle& up) {
         swim::RootFrame frame{unit_vector(tangent, "tangent"), unit_vector(side, "side"), unit_vector(up, "up")};
-        const Vec3 d = swim::flap_stroke_direction(unit_vector(fin_axis, "fin_axis"), frame);
-        py::array_t<double> out(3);
-        for (int c = 0; c < 3; ++c) out.mutable_data()[c] = d[c];
-        return out;
+        return vec3_array(swim::flap_stroke_direction(unit_vector(fin_axis, "fin_axis"), frame));
       },
       py::arg("fin_axis"), py::arg("tangent"), py::arg("side"), py::arg("up"),
       "Unit direction a FLAP power stroke moves the fin tip in.");
@@ -141,10 +138,9 @@ void bind_swim(py::module_& m) {
   m.def(
       "swim_accumulate_phase",
       [](const py::handle& frequencies, double dt, double phase0) {
-        auto f = checked_array<double>(frequencies, "frequencies", -1, 0);
+        const std::vector<double> values = to_vector(frequencies, "frequencies");
         finite_number(dt, "dt");
         finite_number(phase0, "phase0");
-        std::vector<double> values(f.data(), f.data() + f.size());
         const std::vector<double> phase = swim::accumulate_phase(values, dt, phase0);
         return to_array(phase);
       },

@@ -30,6 +30,17 @@ ALLOWED = (ValueError, TypeError, IndexError)
 _log = open(LOG, "w", buffering=1) if LOG else None  # noqa: SIM115 - open for the whole run, read after a crash
 
 
+def dict_keys(value, depth=0):
+    """Every key of the dicts inside `value` (dicts in lists in dicts...)."""
+    if depth > 4:
+        return set()
+    if isinstance(value, dict):
+        return {str(k) for k in value} | dict_keys(list(value.values()), depth + 1)
+    if isinstance(value, (list, tuple)):
+        return set().union(*(dict_keys(v, depth + 1) for v in value)) if value else set()
+    return set()
+
+
 def names_an_argument(message, target, kwargs):
     if (
         "incompatible function arguments" in message
@@ -37,13 +48,11 @@ def names_an_argument(message, target, kwargs):
     ):
         return True  # pybind11 lists the signature, every argument by name
     words = set(kwargs) | set(target.extra_names)
+    words |= dict_keys(list(kwargs.values()))  # rig['legs'][0]['limit_min'] names limit_min
     words |= {w.replace("_", " ") for w in words}
     words |= {
         w[:-1] for w in words if w.endswith("s") and len(w) > 4
     }  # "a key shape ..." names key_shapes
-    for value in kwargs.values():  # keys of dict arguments (rig['legs'][0]['heads'])
-        if isinstance(value, dict):
-            words |= {str(k) for k in value}
     return any(re.search(rf"(?<![A-Za-z]){re.escape(w)}", message) for w in words if w)
 
 
