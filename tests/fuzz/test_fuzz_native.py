@@ -27,7 +27,8 @@ LOG = os.environ.get("KODAWARI_FUZZ_LOG")
 # Cases per entry point: Target.examples x SCALE (2.5: ~9,000 cases, about a minute on 2 cores).
 SCALE = float(os.environ.get("KODAWARI_FUZZ_SCALE", "2.5"))
 ALLOWED = (ValueError, TypeError, IndexError)
-_log = open(LOG, "w", buffering=1) if LOG else None  # noqa: SIM115 - open for the whole run, read after a crash
+# Open for the whole run: after a crash the parent reads the case that was running.
+_log = open(LOG, "w", buffering=1) if LOG else None
 
 
 def dict_keys(value, depth=0):
