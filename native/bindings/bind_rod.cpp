@@ -303,6 +303,17 @@ void bind_rod(py::module_& m) {
              return self.frame_cache().latest_before(frame);
            }, py::arg("frame"), "The latest cached frame before `frame`, or None.")
       .def("clear_cache", [](RodSystem& self) { self.frame_cache().clear(); })
+      .def_property(
+          "cache_budget", [](const RodSystem& self) { return self.frame_cache().budget(); },
+          [](RodSystem& self, std::size_t bytes) { self.frame_cache().set_budget(bytes); },
+          "Bytes the frame cache may hold (0: unbounded). Over it, frames thin out to checkpoints\n"
+          "(see rod/frame_cache.hpp): recall_frame() is then False for a dropped frame, which is\n"
+          "recomputed exactly from latest_cached_frame_before() by stepping on.")
+      .def_property_readonly("cache_bytes", [](const RodSystem& self) { return self.frame_cache().bytes(); },
+                             "Bytes the frame cache holds now.")
+      .def_property_readonly("cache_checkpoint_interval",
+                             [](const RodSystem& self) { return self.frame_cache().checkpoint_interval(); },
+                             "Frames between the checkpoints kept once the budget thinned the cache.")
       .def("cached_state", [](const RodSystem& self, int frame) -> py::object {
              const FrameCache::Entry* e = self.frame_cache().find(frame);
              if (e == nullptr) return py::none();

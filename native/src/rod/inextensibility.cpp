@@ -1,45 +1,54 @@
 #include "kodawari/rod/inextensibility.hpp"
 
 #include <cmath>
-#include <cstdio>
-#include <algorithm>
 
 #include "kodawari/rod/oriented_particles.hpp"
 
 namespace kodawari::rod {
 
+namespace {
+// Relative length error at which the Newton steps stop: what is left is closed by the
+// joint-by-joint pass in rod_simulate.cpp, which then moves joints by micrometres.
+constexpr Real kConverged = 1e-5;
+}  // namespace
+
 Real project_chain_lengths(Vec3* x, std::size_t count, const Real* lengths, const Real* inverse_mass,
                            Real* scratch, int newton_steps, int sweeps) {
   if (count < 2) return 0;
   const std::size_t m = count - 1;  // constraints
-  Real* diag = scratch;             // S_kk
-  Real* upper = scratch + m;        // S_k,k+1 (then the Thomas factor)
+  Real* diag = scratch;             // S_kk, then the Thomas pivots
+  Real* upper = scratch + m;        // S_k,k+1
   Real* rhs = scratch + 2 * m;      // -C_k, then lambda_k
-  // Far from the manifold (a fast tip moves several segment lengths per substep on long
-  // chains) a linearisation means little: a few Gauss-Seidel sweeps of the same mass-weighted
-  // distance projection (PBD, each one an exact local projection) bring the chain close first.
+  Real* normals = scratch + 3 * m;  // n_k (3 per constraint) of the linearisation point
+  // Far from the manifold (a fast tip moves bones' lengths per substep on long chains) a
+  // linearisation means little: Gauss-Seidel sweeps of the same mass-weighted distance
+  // projection (PBD, each an exact local projection) bring the chain close first.
   for (int sweep = 0; sweep < sweeps; ++sweep) {
     for (std::size_t k = 0; k < m; ++k) project_distance(x[k], x[k + 1], inverse_mass[k], inverse_mass[k + 1], lengths[k]);
     for (std::size_t k = m; k-- > 0;) project_distance(x[k], x[k + 1], inverse_mass[k], inverse_mass[k + 1], lengths[k]);
   }
   Real worst = 0;
   for (int step = 0; step < newton_steps; ++step) {
-    // Build S = J M^-1 J^T (tridiagonal) and -C. Segment k joins x[k] (gradient -n_k) and
-    // x[k+1] (+n_k); segments k and k+1 share x[k+1]: S_k,k+1 = -w_{k+1} n_k . n_{k+1}.
+    // S = J M^-1 J^T (tridiagonal) and -C. Segment k joins x[k] (gradient -n_k) and x[k+1]
+    // (+n_k); segments k and k+1 share x[k+1]: S_k,k+1 = -w_{k+1} n_k . n_{k+1}.
     worst = 0;
-    Vec3 previous_normal = Vec3::Zero();
     for (std::size_t k = 0; k < m; ++k) {
       const Vec3 d = x[k + 1] - x[k];
       const Real len = d.norm();
       const Vec3 normal = len > 1e-12 ? Vec3(d / len) : Vec3::Zero();
+      normals[3 * k] = normal.x();
+      normals[3 * k + 1] = normal.y();
+      normals[3 * k + 2] = normal.z();
       diag[k] = inverse_mass[k] + inverse_mass[k + 1];
-      if (k > 0) upper[k - 1] = -inverse_mass[k] * previous_normal.dot(normal);
+      if (k > 0) {
+        const Real* previous = normals + 3 * (k - 1);
+        upper[k - 1] = -inverse_mass[k] * (previous[0] * normal.x() + previous[1] * normal.y() + previous[2] * normal.z());
+      }
       rhs[k] = lengths[k] - len;
       const Real error = std::abs(rhs[k]) / lengths[k];
       if (error > worst) worst = error;
-      previous_normal = normal;
     }
-    if (worst < 1e-10) break;
+    if (worst < kConverged) break;
     // Thomas algorithm (S is symmetric positive definite: no pivoting needed).
     for (std::size_t k = 1; k < m; ++k) {
       if (!(diag[k - 1] > 0)) continue;
@@ -52,19 +61,11 @@ Real project_chain_lengths(Vec3* x, std::size_t count, const Real* lengths, cons
       if (k + 1 < m) value -= upper[k] * rhs[k + 1];
       rhs[k] = diag[k] > 0 ? value / diag[k] : Real(0);
     }
-    // dx = M^-1 J^T lambda, with the normals of the linearisation point (the positions
-    // before this step; each is recomputed from them rather than stored).
-    Vec3 old_previous = x[0];
+    // dx = M^-1 J^T lambda.
     for (std::size_t k = 0; k < m; ++k) {
-      const Vec3 old_current = x[k + 1];
-      const Vec3 d = old_current - old_previous;
-      const Real len = d.norm();
-      if (len > 1e-12) {
-        const Vec3 push = rhs[k] * (d / len);
-        x[k] -= inverse_mass[k] * push;
-        x[k + 1] += inverse_mass[k + 1] * push;
-      }
-      old_previous = old_current;
+      const Vec3 push = rhs[k] * Vec3(normals[3 * k], normals[3 * k + 1], normals[3 * k + 2]);
+      x[k] -= inverse_mass[k] * push;
+      x[k + 1] += inverse_mass[k + 1] * push;
     }
   }
   return worst;

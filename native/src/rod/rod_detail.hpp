@@ -22,7 +22,7 @@ constexpr Real kSubstepUnit = 24.0;
 constexpr long kMaxSubstepsPerFrame = 4096;
 // A substep is split when a joint would travel more than this many (shortest) segment
 // lengths in it, into at most kMaxSplit parts (rod_simulate.cpp).
-constexpr Real kMaxTravel = 0.5;
+constexpr Real kMaxTravel = 1.0;
 constexpr int kMaxSplit = 16;
 // Rods per work chunk (threads take chunks as they go): about 0.2 ms of work at 16 bones.
 constexpr std::size_t kRodsPerChunk = 16;

@@ -81,7 +81,7 @@ void RodSystem::simulate(std::size_t r, const FrameInput& input, const std::vect
   w.lengths.resize(n);
   w.inverse_mass.assign(n + 1, Real(1));
   w.inverse_mass[0] = 0;  // the root joint is kinematic
-  w.projection.resize(3 * (n + 1));
+  w.projection.resize(6 * (n + 1));
   for (std::size_t k = 0; k < n; ++k) w.lengths[k] = rod.geometry.segment_length(k);
   const Real ellipsoid = [&] {
     Real mean = 0;
@@ -121,13 +121,9 @@ void RodSystem::simulate(std::size_t r, const FrameInput& input, const std::vect
   const Vec3 gravity = world_to_armature * (input.gravity * p.gravity);
   const Real base_dt = 1 / rate;
   const Real min_length = *std::min_element(w.lengths.begin(), w.lengths.end());
-  Real chain_length = 0;
-  for (Real l : w.lengths) chain_length += l;
-  // How far the anchor carries the chain per substep (translation plus the sweep of the
-  // chain's extent by its turn): part of the travel that decides the split below.
-  const Real anchor_turn = 2 * std::acos(std::min(Real(1), std::abs(anchor_start_rotation.dot(anchor_end_rotation))));
-  const Real anchor_travel =
-      steps > 0 ? ((anchor_end - anchor_start).norm() + anchor_turn * chain_length) / Real(steps) : Real(0);
+  // How far the root moves per substep: the root's segment must take that up. (The anchor's
+  // turn moves only the ghost behind the root, which the length projection does not see.)
+  const Real anchor_travel = steps > 0 ? (anchor_end - anchor_start).norm() / Real(steps) : Real(0);
 
   w.orientation_terms.resize(count);
   w.orientation_quats.resize(count);
@@ -143,11 +139,7 @@ void RodSystem::simulate(std::size_t r, const FrameInput& input, const std::vect
     Real fastest = 0;
     for (std::size_t j = 2; j < count; ++j) fastest = std::max(fastest, s.v[j].squaredNorm());
     const Real travel = (std::sqrt(fastest) + gravity.norm() * base_dt) * base_dt + anchor_travel;
-    // Gravity alone drops every joint by g dt² while the root holds: the root's segment must
-    // take up the whole chain's drop, count g dt², which must stay within kMaxTravel too.
-    const Real chain_drop = Real(count) * gravity.norm() * base_dt * base_dt;
-    const Real split_needed = std::max(std::ceil(travel / (kMaxTravel * min_length)),
-                                       std::ceil(std::sqrt(chain_drop / (kMaxTravel * min_length))));
+    const Real split_needed = std::ceil(travel / (kMaxTravel * min_length));
     const int split = static_cast<int>(std::clamp(split_needed, Real(1), Real(kMaxSplit)));
     const Real dt = base_dt / Real(split);
     const Real inverse_dt = 1 / dt;
