@@ -1,5 +1,6 @@
-// A rod's rest shape each frame: the condition weights of its keys (view, pose,
-// speed), their blend, and momentum control when the blend changes.
+// A rod's rest shape each frame (docs/algorithms.md §3.2, §3.4): the condition weights of
+// its keys (view, pose, speed; Koyama & Igarashi 2013, "View-dependent control of elastic
+// rod simulation"), their blend, and momentum control when the blend changes.
 #include "kodawari/rod/rod_system.hpp"
 
 #include <algorithm>

@@ -1,5 +1,6 @@
-// One frame of one rod: substeps of oriented-particle shape matching (Müller &
-// Chentanez 2011) with exact inextensibility (rod/inextensibility.hpp).
+// One frame of one rod (docs/algorithms.md §3.3): substeps of oriented-particle shape
+// matching (Müller & Chentanez 2011, "Solid simulation with oriented particles") with
+// exact inextensibility (rod/inextensibility.hpp, Goldenthal et al. 2007).
 #include "kodawari/rod/rod_system.hpp"
 
 #include <algorithm>
@@ -245,7 +246,7 @@ void RodSystem::simulate(std::size_t r, const FrameInput& input, const std::vect
         for (std::size_t j = 2; j < count; ++j) push_out_of_colliders(x[j], colliders, p.radius);
       }
     }
-    // Inextensibility (docs/algorithms.md, "Rods: inextensibility"): the mass-weighted
+    // Inextensibility (docs/algorithms.md §3.3 step 3): the mass-weighted
     // projection onto the bone lengths (both ends of every segment move, momentum is kept;
     // rod/inextensibility.hpp), then the collider push-out.
     project_chain_lengths(x + 1, n + 1, w.lengths.data(), w.inverse_mass.data(), w.projection.data());

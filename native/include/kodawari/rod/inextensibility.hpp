@@ -7,9 +7,9 @@
 // Why not "follow the leader" (moving each child onto its parent's sphere, root to tip):
 // that one-sided correction does not conserve momentum, and when v = dx/dt is taken
 // afterwards every correction is passed down to the tip as velocity. On chains of ten
-// or more bones that pumps energy in faster than damping removes it (docs/algorithms.md,
-// "Rods: inextensibility"). A mass-weighted projection moves both ends of each segment,
-// like the PBD distance constraint it converges to, and only ever removes energy.
+// or more bones that pumps energy in faster than damping removes it (docs/algorithms.md
+// §3.3 step 3). A mass-weighted projection moves both ends of each segment, like the PBD
+// distance constraint (Müller et al. 2007) it generalises, and keeps momentum.
 #pragma once
 
 #include <cstddef>
