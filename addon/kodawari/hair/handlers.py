@@ -8,7 +8,7 @@ from . import runtime
 
 @persistent
 def on_frame_change(scene, depsgraph=None):
-    runtime.evaluate_scene(scene)
+    runtime.evaluate_scene(scene, depsgraph)
 
 
 @persistent
