@@ -65,3 +65,25 @@ def test_an_unconnected_rolled_chain_starts_from_its_rest_pose_without_a_pop(emp
     for a, b in zip(frames, frames[1:]):
         change = max(angle_deg(qa, qb) for qa, qb in zip(a, b))
         assert change < 5.0, f"a joint turned {change:.1f} degrees in one frame with the head still"
+
+
+def test_a_rod_follows_its_root_bone_through_a_rename(empty_scene):
+    from kodawari.hair import runtime
+
+    obj = make_vrm_like_rig(empty_scene, bones=6)
+    rod = _add_rod(obj)
+    add_camera(empty_scene, "Front", (0, -4, 1.5))
+    obj.data.bones["J_Sec_Hair1_01"].name = "Hair_Side_L.001"
+    runtime.clear()  # what undo (pushed by the rename) does: runtimes rebuild from settings
+    head = obj.pose.bones["J_Bip_C_Head"]
+    for frame, location in ((1, (0, 0, 0)), (6, (0.3, 0, 0))):
+        head.location = location
+        head.keyframe_insert("location", frame=frame)
+    for frame in range(1, 13):
+        empty_scene.frame_set(frame)
+    rt = runtime.get(obj)
+    assert rt.error == ""
+    assert rod.root_bone == "Hair_Side_L.001"
+    assert list(rt.rod_slots) == [0], "the renamed rod must still be simulated"
+    moved = max(angle_deg(tuple(pb.rotation_quaternion), (1, 0, 0, 0)) for pb in _chain(obj)[1:])
+    assert moved > 1.0, "the head's motion should swing the renamed chain"
