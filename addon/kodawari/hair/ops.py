@@ -144,7 +144,7 @@ class KODAWARI_OT_rod_add(_HairOperator, bpy.types.Operator):
         settings = obj.kodawari_hair
         for root, chain in plans:
             rod = settings.rods.add()
-            rod.root_bone = root.name
+            rod.root_bone = root.name  # tags the root bone with the rod's identity (props._root_changed)
             for bone in chain:
                 pb = obj.pose.bones[bone.name]
                 if pb.rotation_mode != "QUATERNION":

@@ -4,7 +4,7 @@ import math
 
 import bpy
 
-from . import runtime
+from . import chains, runtime
 
 # Influence for which a view key keeps half its weight 60 degrees away:
 # ((cos 60° + 1) / 2) ** p = 0.5  ->  p = ln 0.5 / ln 0.75 ≈ 2.41 (docs/algorithms.md §3.2).
@@ -20,6 +20,18 @@ CONDITION_CODES = {"VIEW": 0, "POSE": 1, "SPEED": 2}
 
 def _changed(self, context):
     runtime.invalidate(self.id_data)
+
+
+def _root_changed(self, context):
+    """A root bone named by hand: the rod's identity moves to that bone (or, when no bone has
+    that name, the rod lets go of its old one instead of snapping back to it)."""
+    obj = self.id_data
+    pose_bone = obj.pose.bones.get(self.root_bone) if obj.pose is not None else None
+    if pose_bone is not None:
+        chains.tag_root(pose_bone, self)
+    elif self.uid:
+        self.uid = ""
+    runtime.invalidate(obj)
 
 
 class KodawariHairJoint(bpy.types.PropertyGroup):
@@ -47,7 +59,7 @@ class KodawariHairKey(bpy.types.PropertyGroup):
 
 
 class KodawariHairRod(bpy.types.PropertyGroup):
-    root_bone: bpy.props.StringProperty(name="Root Bone", update=_changed,
+    root_bone: bpy.props.StringProperty(name="Root Bone", update=_root_changed,
                                         description="First bone of the chain; its parent is the kinematic anchor")
     reference_bone: bpy.props.StringProperty(
         name="Reference Bone", update=_changed,
@@ -69,6 +81,9 @@ class KodawariHairRod(bpy.types.PropertyGroup):
                                         description="World-space wind velocity, m/s; gusts vary it over time")
     keys: bpy.props.CollectionProperty(type=KodawariHairKey)
     active_key: bpy.props.IntProperty(name="Active Key", default=0, min=0)
+    # Identity of the rod, also stored on its root pose bone (chains.ROD_ID_PROPERTY): a
+    # custom property travels with the bone through renames, so the rod finds it again.
+    uid: bpy.props.StringProperty(name="Rod ID", options={"HIDDEN"})
 
 
 class KodawariHairCollider(bpy.types.PropertyGroup):
