@@ -48,6 +48,23 @@ def press_escape():
     win.event_simulate(type="ESC", value="RELEASE")
 
 
+def running_bakes():
+    from kodawari import bake_job
+
+    return bake_job.running_bakes()
+
+
+def assert_progress_shown(title):
+    """While a bake runs the status bar names it, its progress and the Esc hint."""
+    shown = running_bakes()
+    assert len(shown) == 1 and shown[0].startswith(title) and "Esc cancels" in shown[0], shown
+
+
+def assert_nothing_running():
+    """No bake left behind: its timer, progress and status text went with it."""
+    assert running_bakes() == [], running_bakes()
+
+
 def wait_until(condition, what):
     start = time.monotonic()
     while not condition():
@@ -91,9 +108,11 @@ def fish_bake_escape():
     before = fish_state(obj, cache)
     invoke("kodawari.swim_bake", frame_start=1, frame_end=2000, target="MESH_CACHE", filepath=cache)
     yield 0.05
+    assert_progress_shown("Fish swim bake")
     press_escape()
     yield 0.5
     assert fish_state(obj, cache) == before, (before, fish_state(obj, cache))
+    assert_nothing_running()
 
 
 def fish_bake_completes():
@@ -102,6 +121,7 @@ def fish_bake_completes():
     invoke("kodawari.swim_bake", frame_start=1, frame_end=12, target="MESH_CACHE", filepath=cache)
     yield from wait_until(lambda: any(m.type == "MESH_CACHE" for m in obj.modifiers), "the Mesh Cache modifier")
     assert os.path.getsize(cache) == 32 + 12 * len(obj.data.vertices) * 12
+    assert_nothing_running()
 
 
 # --- gait ----------------------------------------------------------------------
@@ -127,9 +147,11 @@ def gait_bake_escape():
     before = gait_state(rig)
     invoke("kodawari.gait_bake", frame_start=1, frame_end=20000)
     yield 0.03
+    assert_progress_shown("Gait bake")
     press_escape()
     yield 0.5
     assert gait_state(rig) == before, "Esc left gait channels behind"
+    assert_nothing_running()
 
 
 def gait_bake_completes():
@@ -167,20 +189,57 @@ def hair_bake_escape():
     before = hair_state(rig)
     invoke("kodawari.rod_bake", frame_start=1, frame_end=5000)
     yield 0.05
+    assert_progress_shown("Hair bake")
     press_escape()
     yield 0.5
     assert hair_state(rig) == before, (before, hair_state(rig))
+    assert_nothing_running()
 
 
 def hair_bake_completes():
     scene, rig = hair_scene()
     invoke("kodawari.rod_bake", frame_start=1, frame_end=24)
-    yield from wait_until(lambda: not rig.kodawari_hair.enabled, "the bake to finish")
+    yield from wait_until(lambda: not running_bakes(), "the bake to finish")
+    assert not rig.kodawari_hair.enabled, "the live simulation still runs over the bake"
     assert rig.animation_data and rig.animation_data.action, "no action after the bake"
+    assert_nothing_running()
+
+
+def hair_bake_fails_midway():
+    """A frame that cannot be simulated (the armature keyed to scale 0) stops the modal bake:
+    reported, everything put back, no timer or progress left running (issue 11 item 9)."""
+    scene, rig = hair_scene()
+    scene.frame_set(7)
+    before = hair_state(rig)
+    rig.keyframe_insert("scale", frame=1)
+    rig.scale = (0.0, 0.0, 0.0)
+    rig.keyframe_insert("scale", frame=40)
+    rig.scale = (1.0, 1.0, 1.0)
+    action = rig.animation_data.action
+    before = (action.name,) + before[1:]
+    invoke("kodawari.rod_bake", frame_start=1, frame_end=400)
+    yield from wait_until(lambda: not running_bakes(), "the failed bake to stop")
+    yield 0.2
+    assert hair_state(rig) == before, (before, hair_state(rig))
+    assert rig.animation_data.action == action
+    assert not any("rotation_quaternion" in c.data_path for c in action.fcurves), "bake channels left behind"
+
+
+def fish_bake_of_unsaved_file_is_refused():
+    """The default cache path needs a saved file: refused before anything starts (issue 11 item 4)."""
+    scene, obj = fish_scene()
+    try:
+        bpy.ops.kodawari.swim_bake("INVOKE_DEFAULT", target="MESH_CACHE")
+        raise AssertionError("the bake of an unsaved file started")
+    except RuntimeError as exc:
+        assert "Save the file first" in str(exc), exc
+    assert obj.kodawari_swim.baked == "NONE" and not any(m.type == "MESH_CACHE" for m in obj.modifiers)
+    assert_nothing_running()
+    yield 0.1
 
 
 SCENARIOS = [fish_bake_escape, fish_bake_completes, gait_bake_escape, gait_bake_completes,
-             hair_bake_escape, hair_bake_completes]
+             hair_bake_escape, hair_bake_completes, hair_bake_fails_midway, fish_bake_of_unsaved_file_is_refused]
 results = []
 state = {"index": -1, "runner": None, "start": 0.0}
 

@@ -3,6 +3,7 @@
 import bpy
 from bpy.app.handlers import persistent
 
+from .. import problems
 from . import runtime
 
 
@@ -16,7 +17,10 @@ def on_load(filepath=None):
     runtime.clear()
     for obj in bpy.data.objects:
         if obj.type == "ARMATURE" and len(obj.kodawari_hair.rods):
-            runtime.restore_state(obj)
+            try:
+                runtime.restore_state(obj)
+            except Exception as exc:  # noqa: BLE001 - one broken rig never stops the others
+                problems.report(obj, "hair", exc)
 
 
 @persistent
