@@ -59,6 +59,7 @@ class SwimBakeJob(BakeJob):
         self.travel = []  # speed mode: the object's travel per frame
         self.follow = None
         self.stepped = False
+        self.was_enabled = None  # set by prepare: the live switch to put back
 
     def prepare(self):
         obj = self.obj
@@ -77,6 +78,10 @@ class SwimBakeJob(BakeJob):
             self.handle = cache_paths.open_partial(self.absolute_path)
             count = len(obj.data.vertices)
             self.handle.write(pc2_header(count, self.frames[0], 1.0, len(self.frames)))
+        # The bake evaluates the fish itself: the live frame handler leaves it alone meanwhile.
+        self.was_enabled = obj.kodawari_swim.enabled
+        with runtime.batch(obj):
+            obj.kodawari_swim.enabled = False
 
     def step(self):
         frame = self.frames[self.index]
@@ -104,8 +109,12 @@ class SwimBakeJob(BakeJob):
             cache_paths.discard_partial(self.handle, self.absolute_path)
             self.handle = None
         self.keys = []
+        settings = self.obj.kodawari_swim
+        if self.was_enabled is not None:
+            with runtime.batch(self.obj):
+                settings.enabled = self.was_enabled
+            self.was_enabled = None
         if self.stepped:
-            settings = self.obj.kodawari_swim
             if settings.speed_mode != "NONE" and self.follow is None:
                 self.obj.delta_location = settings.rest_delta_location
             self._restore_frame()
@@ -167,6 +176,9 @@ class SwimBakeJob(BakeJob):
         if block is not None:
             block.value = 0.0
         settings.baked = self.target
+        with runtime.batch(obj):
+            settings.enabled = self.was_enabled
+        self.was_enabled = None
         self._restore_frame()
         where = f"to {self.filepath}" if self.target == "MESH_CACHE" else "to shape keys"
         return f"Baked {len(self.frames)} frames of '{obj.name}' {where}; live evaluation is off"
