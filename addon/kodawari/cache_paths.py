@@ -13,6 +13,8 @@ import bpy
 from .bake_job import BakeError
 
 FOLDER_PREFIX = "blendcache_"
+# File-path properties that hold `//` paths say so from Blender 4.5 (older ones refuse the flag).
+RELATIVE_PATH_OPTIONS = {"PATH_SUPPORTS_BLEND_RELATIVE"} if bpy.app.version >= (4, 5, 0) else set()
 SAVE_FIRST = "Save the file first: caches are written beside the .blend, in a folder named after it"
 
 

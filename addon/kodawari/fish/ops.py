@@ -9,7 +9,7 @@ import bpy
 import numpy as np
 from bpy.props import EnumProperty, FloatProperty, IntProperty, StringProperty
 
-from .. import bulk, editable, fcurves, native
+from .. import bulk, cache_paths, editable, fcurves, native
 from ..bake_job import BakeError, BakeOperator, frame_range
 from . import bake, finder, midline, presets, runtime, validate
 from . import fins as fin_setup
@@ -355,6 +355,7 @@ class KODAWARI_OT_swim_bake(BakeOperator, bpy.types.Operator):
         name="File",
         description="PC2 file (empty: in the folder blendcache_<file name> beside the .blend)",
         subtype="FILE_PATH",
+        options=cache_paths.RELATIVE_PATH_OPTIONS,
     )
 
     def make_job(self, context):
