@@ -33,8 +33,6 @@ def _empty_path(fish):
 
 @pytest.mark.parametrize("breakage", ["deleted_group", "renamed_group", "empty_path"])
 def test_a_broken_fish_is_reported_once_and_the_others_keep_swimming(empty_scene, capfd, breakage):
-    from kodawari import problems
-
     broken, healthy = _two_fish()
     capfd.readouterr()
     if breakage == "deleted_group":
@@ -58,6 +56,8 @@ def test_a_broken_fish_is_reported_once_and_the_others_keep_swimming(empty_scene
     said = [line for line in (out + err).splitlines() if "a_broken" in line]
     assert len(said) == 1, out + err  # once, not once per frame
     assert "Traceback" not in out + err
+    from kodawari import problems
+
     status = problems.message(broken, "swim")
     for word in words:
         assert word in status and word in said[0], (status, said)
@@ -72,8 +72,6 @@ def test_a_broken_fish_is_reported_once_and_the_others_keep_swimming(empty_scene
 
 
 def test_a_broken_fish_does_not_stop_a_file_from_opening(empty_scene, tmp_path, capfd):
-    from kodawari import problems
-
     broken, healthy = _two_fish()
     broken.vertex_groups.remove(broken.vertex_groups["fin_dorsal"])
     path = str(tmp_path / "broken.blend")
@@ -82,6 +80,8 @@ def test_a_broken_fish_does_not_stop_a_file_from_opening(empty_scene, tmp_path, 
     bpy.ops.wm.open_mainfile(filepath=path)
     out, err = capfd.readouterr()
     assert "Traceback" not in out + err, out + err
+    from kodawari import problems
+
     assert "fin_dorsal" in problems.message(bpy.data.objects["a_broken"], "swim")
     healthy = bpy.data.objects["b_healthy"]
     before = live(healthy).copy()
