@@ -23,6 +23,8 @@ import traceback
 import bpy
 from bpy.props import IntProperty
 
+from . import problems
+
 
 class BakeError(Exception):
     """A bake refused or failed; the message is written for the user's report area."""
@@ -64,12 +66,13 @@ def failure_message(job, exc):
         return str(exc)
     if isinstance(exc, OSError) and exc.strerror:
         where = f" '{exc.filename}'" if exc.filename else ""
-        detail = f"{exc.strerror}{where}"
-    elif isinstance(exc, (ValueError, KeyError, AttributeError, IndexError, RuntimeError)):
-        detail = str(exc) or type(exc).__name__
-    else:
-        detail = f"{type(exc).__name__}: {exc}"
+        return f"{job.title} failed and was undone: {exc.strerror}{where}"
+    if not isinstance(exc, (ValueError, KeyError, AttributeError, IndexError, RuntimeError)):
         traceback.print_exc()  # an unexpected failure: the console keeps the details for a bug report
+    try:  # the creature's own words for what broke (a deleted fin group, an empty path...)
+        detail = problems.describe(job.obj, exc)
+    except Exception:  # noqa: BLE001 - a job without an object, or the object is gone
+        detail = f"{type(exc).__name__}: {exc}"
     return f"{job.title} failed and was undone: {detail}"
 
 

@@ -52,9 +52,10 @@ def report(obj, feature, exc):
     _messages[key] = message
     line = f"Kodawari {feature}: '{name}' stopped: {message}"
     print(line)
-    _pending.append(line)
-    if not bpy.app.background and len(_pending) == 1:
-        bpy.app.timers.register(_show_pending, first_interval=0.1)
+    if not bpy.app.background:  # headless, the console is where the user looks
+        _pending.append(line)
+        if len(_pending) == 1:
+            bpy.app.timers.register(_show_pending, first_interval=0.1)
     return message
 
 

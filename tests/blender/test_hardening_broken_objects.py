@@ -67,6 +67,7 @@ def test_a_broken_fish_is_reported_once_and_the_others_keep_swimming(empty_scene
     with pytest.raises(RuntimeError) as info:
         bpy.ops.kodawari.swim_bake(frame_start=1, frame_end=4, target="SHAPE_KEYS")
     assert "Traceback" not in str(info.value) and broken.kodawari_swim.baked == "NONE", info.value
+    assert words[0] in str(info.value), info.value
     activate(healthy)
     assert bpy.ops.kodawari.swim_bake(frame_start=1, frame_end=4, target="SHAPE_KEYS") == {"FINISHED"}
 
