@@ -55,7 +55,9 @@ def frame_range(operator, scene):
     start = operator.frame_start if props.is_property_set("frame_start") else scene.frame_start
     end = operator.frame_end if props.is_property_set("frame_end") else scene.frame_end
     if end < start:
-        raise BakeError(f"End frame {end} is before start frame {start}: set an end at or after the start")
+        raise BakeError(
+            f"End frame {end} is before start frame {start}: set an end at or after the start"
+        )
     operator.frame_start, operator.frame_end = start, end
     return start, end
 
@@ -114,8 +116,16 @@ _running = {}
 
 # Events a running bake lets through: looking around the viewport changes no data.
 NAVIGATION_EVENTS = {
-    "MIDDLEMOUSE", "WHEELUPMOUSE", "WHEELDOWNMOUSE", "WHEELINMOUSE", "WHEELOUTMOUSE",
-    "TRACKPADPAN", "TRACKPADZOOM", "MOUSEMOVE", "INBETWEEN_MOUSEMOVE", "NDOF_MOTION",
+    "MIDDLEMOUSE",
+    "WHEELUPMOUSE",
+    "WHEELDOWNMOUSE",
+    "WHEELINMOUSE",
+    "WHEELOUTMOUSE",
+    "TRACKPADPAN",
+    "TRACKPADZOOM",
+    "MOUSEMOVE",
+    "INBETWEEN_MOUSEMOVE",
+    "NDOF_MOTION",
 }
 SECONDS_PER_TICK = 0.05  # work per timer tick: the window stays responsive to Esc
 
@@ -138,9 +148,12 @@ class BakeOperator:
     _timer = None
     _workspace = None
 
-    frame_start: IntProperty(name="Start", description="First frame to bake (unset: the scene's start)",
-                             default=1)
-    frame_end: IntProperty(name="End", description="Last frame to bake (unset: the scene's end)", default=250)
+    frame_start: IntProperty(
+        name="Start", description="First frame to bake (unset: the scene's start)", default=1
+    )
+    frame_end: IntProperty(
+        name="End", description="Last frame to bake (unset: the scene's end)", default=250
+    )
 
     def make_job(self, context):
         raise NotImplementedError

@@ -59,7 +59,9 @@ def check_target(obj, path):
         raise BakeError(f"{SAVE_FIRST} ('{path}' is relative to it)")
     target = _absolute(path)
     if path.endswith(("/", "\\")) or os.path.isdir(target):
-        raise BakeError(f"'{path}' is a folder: give a file name, such as {bpy.path.clean_name(obj.name)}.pc2")
+        raise BakeError(
+            f"'{path}' is a folder: give a file name, such as {bpy.path.clean_name(obj.name)}.pc2"
+        )
     owner = caches_in_use(except_obj=obj).get(target)
     if owner is not None:
         raise BakeError(f"'{path}' is the cache of '{owner}': choose another file")
@@ -78,7 +80,7 @@ def open_partial(target):
     try:
         os.makedirs(os.path.dirname(target) or ".", exist_ok=True)
         # Kept open across the bake's steps; closed by the job's finish() or cancel().
-        return open(target + ".part", "wb")  # noqa: SIM115
+        return open(target + ".part", "wb")
     except OSError as exc:
         raise BakeError(f"Cannot write the cache '{target}': {exc.strerror or exc}") from exc
 

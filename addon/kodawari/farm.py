@@ -35,7 +35,9 @@ def _ensure_registered():
     if not hasattr(bpy.types.Object, "kodawari_swim"):
         from . import native
 
-        raise BakeError(f"Kodawari could not start: {native.error() or 'the add-on did not register'}")
+        raise BakeError(
+            f"Kodawari could not start: {native.error() or 'the add-on did not register'}"
+        )
 
 
 def _gait_ready(obj):
@@ -57,7 +59,10 @@ def _jobs(scene, context):
             yield obj.name, lambda obj=obj: GaitBakeJob(context, obj, start, end)
     for obj in objects:
         if obj.type == "MESH" and fish_runtime.is_live(obj):
-            yield obj.name, lambda obj=obj: fish_bake.SwimBakeJob(obj, scene, start, end, "MESH_CACHE")
+            yield (
+                obj.name,
+                lambda obj=obj: fish_bake.SwimBakeJob(obj, scene, start, end, "MESH_CACHE"),
+            )
     for obj in objects:
         if obj.type == "ARMATURE" and obj.kodawari_hair.enabled and len(obj.kodawari_hair.rods):
             yield obj.name, lambda obj=obj: HairBakeJob(obj, scene, start, end)
@@ -76,7 +81,9 @@ def bake_all(save=True, exit_on_failure=None):
     try:
         _ensure_registered()
         if not bpy.data.filepath:
-            raise BakeError("Save the file first: caches are written beside the .blend, in a folder named after it")
+            raise BakeError(
+                "Save the file first: caches are written beside the .blend, in a folder named after it"
+            )
         done, failed = _bake_scenes()
         if save and done:
             bpy.ops.wm.save_mainfile()

@@ -9,6 +9,9 @@ A handler runs on every frame; a broken object must not print a traceback per fr
 so the same message for the same object is said once.
 """
 
+# bl_options sets are Blender's class-attribute convention, never mutated.
+# ruff: noqa: RUF012
+
 import bpy
 
 _messages = {}  # (feature, object name) -> the message shown in the panel
@@ -22,17 +25,25 @@ def _key(obj, feature):
 def describe(obj, exc):
     """A user's sentence for what broke, with what to do where we know it."""
     swim = getattr(obj, "kodawari_swim", None)
-    if swim is not None and getattr(obj, "type", "") == "MESH" and swim.enabled:
+    if swim is not None and getattr(obj, "type", "") == "MESH":
         missing = [f.vertex_group for f in swim.fins if f.vertex_group not in obj.vertex_groups]
         if missing:
-            return (f"fin vertex group '{missing[0]}' is missing (deleted or renamed): "
-                    "rename it back, or remove the fin")
+            return (
+                f"fin vertex group '{missing[0]}' is missing (deleted or renamed): "
+                "rename it back, or remove the fin"
+            )
         for constraint in obj.constraints:
             target = getattr(constraint, "target", None)
-            if constraint.type == "FOLLOW_PATH" and target is not None and target.type == "CURVE":
-                if not any(len(s.points) + len(s.bezier_points) for s in target.data.splines):
-                    return (f"the Follow Path curve '{target.name}' has no points: draw the path, "
-                            "or remove the constraint")
+            if (
+                constraint.type == "FOLLOW_PATH"
+                and target is not None
+                and target.type == "CURVE"
+                and not any(len(s.points) + len(s.bezier_points) for s in target.data.splines)
+            ):
+                return (
+                    f"the Follow Path curve '{target.name}' has no points: draw the path, "
+                    "or remove the constraint"
+                )
     if isinstance(exc, KeyError):
         return f"'{exc.args[0] if exc.args else ''}' is missing (deleted or renamed?)"
     text = str(exc)
@@ -83,7 +94,6 @@ def _show_pending():
             bpy.ops.kodawari.report_problem("EXEC_DEFAULT", message=line)
         except RuntimeError:
             pass  # the operator reports by cancelling, which bpy.ops raises on; the message is shown
-    return None
 
 
 class KODAWARI_OT_report_problem(bpy.types.Operator):

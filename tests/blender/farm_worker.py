@@ -12,10 +12,11 @@ import os
 import sys
 
 import bpy  # first: importing bpy puts Blender's own modules (addon_utils) on sys.path
-import addon_utils  # noqa: E402
 
 
 def _enable_addon():
+    import addon_utils
+
     addon_utils.modules_refresh()
     addon_utils.enable("kodawari", default_set=False)
     assert hasattr(bpy.types.Object, "kodawari_swim"), "the add-on did not register"
@@ -42,6 +43,8 @@ def render(blend, out, addon, frames):
 def main(argv):
     mode, blend = argv[0], argv[1]
     if mode == "bake":
+        import addon_utils
+
         bpy.ops.wm.open_mainfile(filepath=blend)
         addon_utils.modules_refresh()
         import kodawari
@@ -52,4 +55,4 @@ def main(argv):
 
 
 if __name__ == "__main__":
-    main(sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else sys.argv[1:])
+    main(sys.argv[sys.argv.index("--") + 1 :] if "--" in sys.argv else sys.argv[1:])

@@ -14,9 +14,10 @@ import sys
 import bpy
 import numpy as np
 import pytest
-from fish_helpers import activate, add_swim, make_fish, set_fps
+from bake_scenes import hair_rig, swimming_fish
+from fish_helpers import activate, make_fish
 from gait_scene import horse
-from hair_rig import add_camera, make_rig, select_only
+from hair_rig import add_camera
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 WORKER = os.path.join(HERE, "farm_worker.py")
@@ -29,7 +30,9 @@ def _blender(*args, cwd):
         command = [bpy.app.binary_path, "-b", "--factory-startup", "-noaudio", *args]
     else:  # the bpy module: its Python, with the worker script
         command = [sys.executable, *args]
-    done = subprocess.run(command, cwd=cwd, capture_output=True, text=True, timeout=300)
+    done = subprocess.run(
+        command, cwd=cwd, capture_output=True, text=True, timeout=300, check=False
+    )
     return done.returncode, done.stdout + done.stderr
 
 
@@ -47,23 +50,17 @@ def _bake_all(blend, cwd):
 
 def _shot(scene, path):
     """A fish, a hair rig with something on its hair, and a galloping horse, in one camera."""
-    set_fps(24)
+    fish = swimming_fish(fins=("fin_dorsal",), frequency=2.0)
     scene.frame_start, scene.frame_end = 1, 12
-    fish = make_fish("tuna")
     fish.location = (0.0, 0.0, 1.0)
-    add_swim(fish, fins=("fin_dorsal",), head_axis="POS_X", frequency=2.0)
-    rig = make_rig(scene)
+    rig = hair_rig(scene, ((1, 0.0), (6, 0.4), (12, -0.3)))
     rig.location = (-2.5, 0.0, 0.0)
-    select_only(rig, {"Ahoge.00"})
-    assert bpy.ops.kodawari.rod_add() == {"FINISHED"}
-    bpy.ops.object.mode_set(mode="OBJECT")
-    head = rig.pose.bones["Head"]
-    for frame, x in ((1, 0.0), (6, 0.4), (12, -0.3)):
-        head.location = (x, 0.0, 0.0)
-        head.keyframe_insert("location", frame=frame)
     bead = bpy.data.objects.new("bead", bpy.data.meshes.new("bead"))
-    bead.data.from_pydata([(x, y, z) for x in (-.15, .15) for y in (-.15, .15) for z in (-.15, .15)], [],
-                          [(0, 1, 3, 2), (4, 6, 7, 5), (0, 4, 5, 1), (2, 3, 7, 6), (0, 2, 6, 4), (1, 5, 7, 3)])
+    bead.data.from_pydata(
+        [(x, y, z) for x in (-0.15, 0.15) for y in (-0.15, 0.15) for z in (-0.15, 0.15)],
+        [],
+        [(0, 1, 3, 2), (4, 6, 7, 5), (0, 4, 5, 1), (2, 3, 7, 6), (0, 2, 6, 4), (1, 5, 7, 3)],
+    )
     scene.collection.objects.link(bead)
     bead.parent, bead.parent_type, bead.parent_bone = rig, "BONE", "Ahoge.04"
     gait = horse(scene, [(1, 3.0), (12, 3.0)])
@@ -103,8 +100,14 @@ def test_a_baked_shot_renders_the_same_without_the_addon(empty_scene, tmp_path):
     images = {}
     for addon in ("addon", "no-addon"):
         out = tmp_path / addon
-        code, output = _worker("render", str(farm / "shot_010.blend"), str(out), addon,
-                               *map(str, FRAMES), cwd=elsewhere)
+        code, output = _worker(
+            "render",
+            str(farm / "shot_010.blend"),
+            str(out),
+            addon,
+            *map(str, FRAMES),
+            cwd=elsewhere,
+        )
         assert code == 0, output
         images[addon] = [_pixels(str(out / f"{frame:04d}.png")) for frame in FRAMES]
     for frame, with_addon, without in zip(FRAMES, images["addon"], images["no-addon"]):
@@ -117,14 +120,9 @@ def test_bake_all_says_which_creature_failed_and_bakes_the_others(empty_scene, t
     import kodawari
     from kodawari.bake_job import BakeError
 
-    set_fps(24)
+    swimming_fish("broken", fins=("fin_dorsal",))
+    swimming_fish("healthy")
     empty_scene.frame_start, empty_scene.frame_end = 1, 6
-    broken = make_fish("tuna")
-    broken.name = "broken"
-    add_swim(broken, fins=("fin_dorsal",), head_axis="POS_X")
-    healthy = make_fish("tuna")
-    healthy.name = "healthy"
-    add_swim(healthy, head_axis="POS_X")
     bpy.ops.wm.save_as_mainfile(filepath=str(tmp_path / "shot.blend"))
     broken = bpy.data.objects["broken"]
     broken.vertex_groups.remove(broken.vertex_groups["fin_dorsal"])

@@ -12,7 +12,9 @@ from fish_helpers import activate, add_swim, evaluated, frames, make_fish, set_f
 def _setup():
     set_fps(24)
     obj = make_fish("tuna")
-    settings = add_swim(obj, fins=("fin_dorsal", "fin_pectoral"), head_axis="POS_X", preset="THUNNIFORM")
+    settings = add_swim(
+        obj, fins=("fin_dorsal", "fin_pectoral"), head_axis="POS_X", preset="THUNNIFORM"
+    )
     settings.bend = "DORSOVENTRAL"
     settings.frequency = 2.5
     settings.speed_mode = "BAINBRIDGE"
@@ -20,8 +22,14 @@ def _setup():
 
 
 def _setup_of(settings):
-    return ([(f.vertex_group, f.kind, f.amplitude) for f in settings.fins], settings.preset, settings.bend,
-            settings.frequency, settings.speed_mode, settings.head_axis)
+    return (
+        [(f.vertex_group, f.kind, f.amplitude) for f in settings.fins],
+        settings.preset,
+        settings.bend,
+        settings.frequency,
+        settings.speed_mode,
+        settings.head_axis,
+    )
 
 
 @pytest.mark.parametrize("target", ["MESH_CACHE", "SHAPE_KEYS"])
@@ -53,7 +61,7 @@ def test_free_bake_keeps_the_setup_and_swims_live_again(empty_scene, tmp_path, t
 
 
 def test_free_bake_on_a_fish_that_is_not_baked_is_refused(empty_scene):
-    obj, settings = _setup()
+    _obj, settings = _setup()
     with pytest.raises(RuntimeError, match="baked swim"):
         bpy.ops.kodawari.swim_free_bake()
     assert settings.enabled and settings.baked == "NONE"

@@ -7,36 +7,29 @@ import os
 import bpy
 import numpy as np
 import pytest
-from fish_helpers import activate, add_swim, make_fish, set_fps
+from bake_scenes import hair_rig, swimming_fish
+from fish_helpers import activate
 from gait_scene import fcurve_snapshot, horse
-from hair_rig import add_camera, make_rig, select_only
+
+HEAD_KEYS = ((1, 0.0), (8, 0.3), (16, -0.2))
 
 
 def _fish(tmp_path):
-    set_fps(24)
-    obj = make_fish("tuna")
-    add_swim(obj, fins=("fin_dorsal",), head_axis="POS_X")
-    return obj
+    return swimming_fish(fins=("fin_dorsal",))
 
 
 def _hair(scene):
-    rig = make_rig(scene)
-    select_only(rig, {"Ahoge.00"})
-    assert bpy.ops.kodawari.rod_add() == {"FINISHED"}
-    bpy.ops.object.mode_set(mode="OBJECT")
-    add_camera(scene, "Front", (0, -4, 1.7))
-    head = rig.pose.bones["Head"]
-    for frame, x in ((1, 0.0), (8, 0.3), (16, -0.2)):
-        head.location = (x, 0.0, 0.0)
-        head.keyframe_insert("location", frame=frame)
-    return rig
+    return hair_rig(scene, HEAD_KEYS)
 
 
 def _key_range(obj, prefix):
     from kodawari import fcurves
 
-    frames = [fcurves.read_keys(c)[0] for c in fcurves.action_fcurves(obj.animation_data.action, obj)
-              if c.data_path.startswith(prefix)]
+    frames = [
+        fcurves.read_keys(c)[0]
+        for c in fcurves.action_fcurves(obj.animation_data.action, obj)
+        if c.data_path.startswith(prefix)
+    ]
     assert frames, prefix
     return int(min(f.min() for f in frames)), int(max(f.max() for f in frames))
 
@@ -100,7 +93,9 @@ def test_a_fish_bake_failing_midway_is_undone(empty_scene, tmp_path, monkeypatch
     empty_scene.frame_set(5)
     modifiers = [m.name for m in obj.modifiers]
     calls = _fails_on_the_third_call(monkeypatch, runtime, "evaluate")
-    _refused_cleanly(bpy.ops.kodawari.swim_bake, frame_start=1, frame_end=20, filepath=str(tmp_path / "f.pc2"))
+    _refused_cleanly(
+        bpy.ops.kodawari.swim_bake, frame_start=1, frame_end=20, filepath=str(tmp_path / "f.pc2")
+    )
     assert calls["n"] >= 3  # the third frame failed (restoring the frame evaluates once more)
     assert os.listdir(tmp_path) == []  # no cache, no .part
     assert [m.name for m in obj.modifiers] == modifiers and obj.kodawari_swim.baked == "NONE"
@@ -119,10 +114,12 @@ def test_a_gait_bake_failing_midway_is_undone(empty_scene, monkeypatch):
     assert rig.animation_data.action == action
     assert fcurve_snapshot(rig) == before
     assert {pb.name: pb.rotation_mode for pb in rig.pose.bones} == modes
-    assert not [k for k in rig.keys() if k.startswith("kodawari_contact")]
+    assert not [k for k in rig.keys() if k.startswith("kodawari_contact")]  # noqa: SIM118 - ID custom properties
 
 
-def test_a_hair_bake_failing_midway_is_undone_and_not_simulated_by_the_live_handler(empty_scene, monkeypatch):
+def test_a_hair_bake_failing_midway_is_undone_and_not_simulated_by_the_live_handler(
+    empty_scene, monkeypatch
+):
     from kodawari.hair import runtime
 
     rig = _hair(empty_scene)
@@ -132,8 +129,11 @@ def test_a_hair_bake_failing_midway_is_undone_and_not_simulated_by_the_live_hand
     before = fcurve_snapshot(rig)
     live = []
     hair_armatures = runtime.hair_armatures
-    monkeypatch.setattr(runtime, "evaluate_scene", lambda scene: live.append(
-        (scene.frame_current, [o.name for o in hair_armatures(scene)])))
+    monkeypatch.setattr(
+        runtime,
+        "evaluate_scene",
+        lambda scene: live.append((scene.frame_current, [o.name for o in hair_armatures(scene)])),
+    )
     _fails_on_the_third_call(monkeypatch, runtime.ArmatureRuntime, "evaluate")
     _refused_cleanly(bpy.ops.kodawari.rod_bake, frame_start=1, frame_end=30)
     assert empty_scene.frame_current == 6 and rig.kodawari_hair.enabled

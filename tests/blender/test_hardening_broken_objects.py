@@ -3,22 +3,17 @@ once (console, report area via the problem operator, its panel status) instead o
 traceback on every frame, the other creatures keep moving, and a bake of it fails
 cleanly with everything put back."""
 
+import itertools
+
 import bpy
 import numpy as np
 import pytest
-from fish_helpers import activate, add_swim, live, make_fish, set_fps
-from hair_rig import add_camera, make_rig, select_only
+from bake_scenes import hair_rig, swimming_fish
+from fish_helpers import activate, live
 
 
 def _two_fish():
-    set_fps(24)
-    broken = make_fish("tuna")
-    broken.name = "a_broken"
-    add_swim(broken, fins=("fin_dorsal",), head_axis="POS_X")
-    healthy = make_fish("tuna")
-    healthy.name = "b_healthy"
-    add_swim(healthy, head_axis="POS_X")
-    return broken, healthy
+    return swimming_fish("a_broken", fins=("fin_dorsal",)), swimming_fish("b_healthy")
 
 
 def _empty_path(fish):
@@ -51,7 +46,9 @@ def test_a_broken_fish_is_reported_once_and_the_others_keep_swimming(empty_scene
     for frame in range(2, 8):
         empty_scene.frame_set(frame)
         shapes.append(live(healthy).copy())
-    assert min(np.abs(a - b).max() for a, b in zip(shapes, shapes[1:])) > 1e-4  # still swims every frame
+    assert (
+        min(np.abs(a - b).max() for a, b in itertools.pairwise(shapes)) > 1e-4
+    )  # still swims every frame
     out, err = capfd.readouterr()
     said = [line for line in (out + err).splitlines() if "a_broken" in line]
     assert len(said) == 1, out + err  # once, not once per frame
@@ -69,7 +66,9 @@ def test_a_broken_fish_is_reported_once_and_the_others_keep_swimming(empty_scene
     assert "Traceback" not in str(info.value) and broken.kodawari_swim.baked == "NONE", info.value
     assert words[0] in str(info.value), info.value
     activate(healthy)
-    assert bpy.ops.kodawari.swim_bake(frame_start=1, frame_end=4, target="SHAPE_KEYS") == {"FINISHED"}
+    assert bpy.ops.kodawari.swim_bake(frame_start=1, frame_end=4, target="SHAPE_KEYS") == {
+        "FINISHED"
+    }
 
 
 def test_a_broken_fish_does_not_stop_a_file_from_opening(empty_scene, tmp_path, capfd):
@@ -92,11 +91,7 @@ def test_a_broken_fish_does_not_stop_a_file_from_opening(empty_scene, tmp_path, 
 
 def test_a_hair_bake_on_a_frame_that_cannot_be_simulated_fails_cleanly(empty_scene):
     """Item 9: armature scale 0 -> a clear message; frame, live switch, action and pose as they were."""
-    rig = make_rig(empty_scene)
-    select_only(rig, {"Ahoge.00"})
-    assert bpy.ops.kodawari.rod_add() == {"FINISHED"}
-    bpy.ops.object.mode_set(mode="OBJECT")
-    add_camera(empty_scene, "Front", (0, -4, 1.7))
+    rig = hair_rig(empty_scene)
     rig.kodawari_hair.enabled = False
     empty_scene.frame_set(9)
     rig.scale = (0.0, 0.0, 0.0)

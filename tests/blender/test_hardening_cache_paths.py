@@ -8,15 +8,12 @@ import os
 import bpy
 import numpy as np
 import pytest
-from fish_helpers import activate, add_swim, evaluated, make_fish, set_fps
+from bake_scenes import swimming_fish
+from fish_helpers import activate, evaluated
 
 
 def _fish(name="tuna", frequency=1.0):
-    set_fps(24)
-    obj = make_fish("tuna")
-    obj.name = name
-    add_swim(obj, head_axis="POS_X", frequency=frequency)
-    return obj
+    return swimming_fish(name, frequency=frequency)
 
 
 def _refused(words, **kwargs):
@@ -79,7 +76,8 @@ def test_two_files_in_one_folder_keep_their_own_fish(empty_scene, tmp_path):
 
 
 def test_objects_whose_names_clean_alike_get_their_own_files(empty_scene, tmp_path):
-    first, second = _fish("tuna.001"), _fish("tuna_001")
+    _fish("tuna.001")
+    _fish("tuna_001")
     bpy.ops.wm.save_as_mainfile(filepath=str(tmp_path / "shot.blend"))
     paths = []
     for name in ("tuna.001", "tuna_001"):

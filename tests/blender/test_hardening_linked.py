@@ -3,9 +3,9 @@ Blender keeps none of the changes on save, so a set-up made on them would be los
 
 import bpy
 import pytest
+from bake_scenes import hair_rig
 from fish_helpers import activate, make_fish
 from gait_scene import horse
-from hair_rig import make_rig, select_only
 
 
 @pytest.fixture
@@ -14,14 +14,11 @@ def linked(empty_scene, tmp_path):
     linked into a new file: {name: linked object}."""
     make_fish("tuna")
     horse(empty_scene, [(1, 2.0), (30, 2.0)])
-    rig = make_rig(empty_scene)
-    select_only(rig, {"Ahoge.00"})
-    assert bpy.ops.kodawari.rod_add() == {"FINISHED"}
-    bpy.ops.object.mode_set(mode="OBJECT")
+    hair_rig(empty_scene)
     library = str(tmp_path / "library.blend")
     bpy.ops.wm.save_as_mainfile(filepath=library)
     bpy.ops.wm.read_homefile(use_empty=True, use_factory_startup=True)
-    with bpy.data.libraries.load(library, link=True) as (source, target):
+    with bpy.data.libraries.load(library, link=True) as (_source, target):
         target.objects = ["tuna", "Horse", "Rig"]
     scene = bpy.context.scene
     for obj in target.objects:

@@ -388,5 +388,7 @@ class KODAWARI_OT_swim_free_bake(bpy.types.Operator):
         runtime.forget(obj)
         if runtime.is_live(obj):
             runtime.evaluate(obj, context.scene)
-        self.report({"INFO"}, f"Freed the bake of '{obj.name}': it swims live again with the same setup")
+        self.report(
+            {"INFO"}, f"Freed the bake of '{obj.name}': it swims live again with the same setup"
+        )
         return {"FINISHED"}

@@ -19,7 +19,9 @@ class HairBakeJob(BakeJob):
     def __init__(self, obj, scene, frame_start, frame_end, new_action=False):
         self.obj, self.scene = obj, scene
         self.start, self.end = frame_start, frame_end
-        self.first = min(scene.frame_start, frame_start)  # live resets at the scene's start: so does the bake
+        self.first = min(
+            scene.frame_start, frame_start
+        )  # live resets at the scene's start: so does the bake
         self.frame = self.first
         self.new_action = new_action
         self.baked = {}
@@ -76,7 +78,11 @@ class HairBakeJob(BakeJob):
             if action is not snap["action"]:
                 bpy.data.actions.remove(action)
             self.created = None
-        if not snap["has_anim"] and obj.animation_data is not None and obj.animation_data.action is None:
+        if (
+            not snap["has_anim"]
+            and obj.animation_data is not None
+            and obj.animation_data.action is None
+        ):
             obj.animation_data_clear()
         obj.pose.bones.foreach_set("rotation_quaternion", snap["rotations"])
         obj.kodawari_hair.enabled = snap["enabled"]
@@ -115,10 +121,20 @@ class HairBakeJob(BakeJob):
         obj.kodawari_hair.enabled = False
         self.scene.frame_set(snap["frame"][0], subframe=snap["frame"][1])
         self.snapshot = None
-        return (f"Baked {len(self.chains)} bones over frames {self.start}-{self.end} into action "
-                f"'{action.name}'" + (" (NLA track)" if self.new_action else "") + "; live simulation turned off")
+        return (
+            f"Baked {len(self.chains)} bones over frames {self.start}-{self.end} into action "
+            f"'{action.name}'"
+            + (" (NLA track)" if self.new_action else "")
+            + "; live simulation turned off"
+        )
 
     def _write(self, action, frames, values):
         for b, name in enumerate(self.chains):
-            fcurves.write_channels(action, self.obj, f'pose.bones["{name}"].rotation_quaternion', frames,
-                                   values[:, b, :], group=name)
+            fcurves.write_channels(
+                action,
+                self.obj,
+                f'pose.bones["{name}"].rotation_quaternion',
+                frames,
+                values[:, b, :],
+                group=name,
+            )
