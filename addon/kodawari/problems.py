@@ -16,6 +16,7 @@ import bpy
 
 _messages = {}  # (feature, object name) -> the message shown in the panel
 _pending = []  # messages waiting for the report area (a timer shows them)
+shown = []  # what the report area was given this session (the UI tests read it)
 
 
 def _key(obj, feature):
@@ -106,5 +107,6 @@ class KODAWARI_OT_report_problem(bpy.types.Operator):
     message: bpy.props.StringProperty(name="Message")
 
     def execute(self, context):
+        shown.append(self.message)
         self.report({"ERROR"}, self.message)
         return {"CANCELLED"}

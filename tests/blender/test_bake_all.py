@@ -116,6 +116,16 @@ def test_a_baked_shot_renders_the_same_without_the_addon(empty_scene, tmp_path):
     assert all(np.abs(first - other).max() > 0 for other in others), "nothing moves in the renders"
 
 
+def test_the_farm_command_exits_non_zero_when_a_creature_fails(empty_scene, tmp_path):
+    swimming_fish("broken", fins=("fin_dorsal",))
+    broken = bpy.data.objects["broken"]
+    broken.vertex_groups.remove(broken.vertex_groups["fin_dorsal"])
+    bpy.ops.wm.save_as_mainfile(filepath=str(tmp_path / "shot.blend"))
+    code, output = _bake_all(str(tmp_path / "shot.blend"), cwd=tmp_path)
+    assert code != 0, output
+    assert "FAILED" in output and "broken" in output and "fin_dorsal" in output, output
+
+
 def test_bake_all_says_which_creature_failed_and_bakes_the_others(empty_scene, tmp_path):
     import kodawari
     from kodawari.bake_job import BakeError

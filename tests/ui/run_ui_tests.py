@@ -225,6 +225,30 @@ def hair_bake_fails_midway():
     assert not any("rotation_quaternion" in c.data_path for c in action.fcurves), "bake channels left behind"
 
 
+def broken_fish_is_reported_once_in_the_report_area():
+    """A fin group deleted under a swimming fish: one report, however many frames play
+    (issue 11 item 8); the fish's modal bake then fails in words, nothing left running."""
+    from kodawari import problems
+    from kodawari.fish import runtime
+
+    scene, obj = fish_scene()
+    assert bpy.ops.kodawari.swim_fin_add(vertex_group="fin_dorsal", kind="DORSAL") == {"FINISHED"}
+    obj.vertex_groups.remove(obj.vertex_groups["fin_dorsal"])
+    runtime.forget()  # rigs rebuild from the file's data, as after undo or reopening
+    shown = len(problems.shown)
+    for frame in range(2, 12):
+        scene.frame_set(frame)
+    yield 0.5
+    said = [line for line in problems.shown[shown:] if "tuna" in line]
+    assert len(said) == 1 and "fin_dorsal" in said[0], problems.shown[shown:]
+    try:
+        bpy.ops.kodawari.swim_bake("INVOKE_DEFAULT", frame_start=1, frame_end=50, target="SHAPE_KEYS")
+        raise AssertionError("the bake of a broken fish started")
+    except RuntimeError as exc:
+        assert "fin_dorsal" in str(exc) and "Traceback" not in str(exc), exc
+    assert_nothing_running()
+
+
 def fish_bake_of_unsaved_file_is_refused():
     """The default cache path needs a saved file: refused before anything starts (issue 11 item 4)."""
     scene, obj = fish_scene()
@@ -239,7 +263,8 @@ def fish_bake_of_unsaved_file_is_refused():
 
 
 SCENARIOS = [fish_bake_escape, fish_bake_completes, gait_bake_escape, gait_bake_completes,
-             hair_bake_escape, hair_bake_completes, hair_bake_fails_midway, fish_bake_of_unsaved_file_is_refused]
+             hair_bake_escape, hair_bake_completes, hair_bake_fails_midway, fish_bake_of_unsaved_file_is_refused,
+             broken_fish_is_reported_once_in_the_report_area]
 results = []
 state = {"index": -1, "runner": None, "start": 0.0}
 
