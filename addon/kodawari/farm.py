@@ -8,6 +8,7 @@ Cache modifier from `//blendcache_<file>/`, relative to the .blend.
 Order matters: gaits first (hair may hang from a galloping horse), then fish, then hair.
 """
 
+import os
 import sys
 
 import bpy
@@ -102,10 +103,24 @@ def bake_all(save=True, exit_on_failure=None):
     return done
 
 
+def _missing_caches(scene):
+    """Fish baked earlier whose PC2 is not where the file looks: they would render frozen."""
+    for obj in scene.objects:
+        for modifier in getattr(obj, "modifiers", ()):
+            if modifier.type == "MESH_CACHE" and obj.kodawari_swim.baked == "MESH_CACHE":
+                path = bpy.path.abspath(modifier.filepath, library=obj.library)
+                if not os.path.isfile(path):
+                    yield (
+                        f"{scene.name}/{obj.name}: its cache '{modifier.filepath}' is missing: "
+                        "copy the blendcache folder with the .blend, or Free Bake and bake again"
+                    )
+
+
 def _bake_scenes():
     done, failed = [], []
     active = bpy.context.scene
     for scene in bpy.data.scenes:
+        failed.extend(_missing_caches(scene))
         context = bpy.context if scene == active else _SceneContext(scene)
         for name, make in list(_jobs(scene, context)):
             try:

@@ -141,8 +141,14 @@ def test_bake_all_says_which_creature_failed_and_bakes_the_others(empty_scene, t
     runtime.forget()
     with pytest.raises(BakeError, match="broken.*fin_dorsal"):
         kodawari.bake_all(exit_on_failure=False)
-    assert bpy.data.objects["healthy"].kodawari_swim.baked == "MESH_CACHE"
+    healthy = bpy.data.objects["healthy"]
+    assert healthy.kodawari_swim.baked == "MESH_CACHE"
     assert bpy.data.objects["broken"].kodawari_swim.baked == "NONE"
+    # A cache that did not travel with the file is a failure too, not a frozen fish.
+    os.remove(bpy.path.abspath(healthy.modifiers["Kodawari Swim Cache"].filepath))
+    bpy.data.objects.remove(bpy.data.objects["broken"])
+    with pytest.raises(BakeError, match="healthy.*cache .* is missing"):
+        kodawari.bake_all(exit_on_failure=False)
 
 
 def test_bake_all_of_an_unsaved_file_asks_to_save(empty_scene):

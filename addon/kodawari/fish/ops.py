@@ -159,6 +159,10 @@ class KODAWARI_OT_swim_remove(bpy.types.Operator):
         ):
             self.report({"ERROR"}, f"'{obj.name}' has no Fish Swim to remove")
             return {"CANCELLED"}
+        error = editable.why_not(obj, "lose its swim")
+        if error:
+            self.report({"ERROR"}, error)
+            return {"CANCELLED"}
         with runtime.batch(obj):
             remove_swim(obj)
         self.report({"INFO"}, f"Fish Swim removed from '{obj.name}'; its mesh is as it was")
