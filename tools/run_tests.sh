@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
 # Every test tier, then one summary; exits non-zero when any tier fails.
+#   ruff     ruff check and ruff format --check over the Python sources
 #   native   C++ GoogleTest through ctest
 #   python   pytest against kodawari_native, no Blender
 #   blender-3.4  the real program: blender -b ... --python tests/blender/run_pytest.py
@@ -25,6 +26,14 @@ tier() {  # name, command...
 
 source tools/blender_env.sh
 
+ruff_tier() {  # lint + format check of the Python sources (rules: pyproject.toml [tool.ruff])
+  local sources=(addon tests tools blend_samples) rc=0
+  "$VENV/bin/ruff" check --output-format junit --exit-zero -o "$REPORTS/ruff.xml" "${sources[@]}"
+  "$VENV/bin/ruff" check "${sources[@]}" || rc=1
+  "$VENV/bin/ruff" format --check "${sources[@]}" || rc=1
+  return $rc
+}
+tier ruff ruff_tier
 tier native ctest --test-dir "$BUILD" --output-on-failure --output-junit "$REPORTS/native.xml"
 tier python env PYTHONPATH="$PWD/addon/kodawari" "$VENV/bin/python" -m pytest -q -p no:cacheprovider tests/python --junitxml="$REPORTS/python.xml"
 pip_install_tier() {  # `pip install .` (scikit-build-core, same CMake) into a scratch folder, then the Python tests on it

@@ -1,4 +1,4 @@
-// Python face of the control-axis FFD; the contract is FFD_API.md. Thin: checks
+// Python face of the control-axis FFD; the algorithm is docs/algorithms.md §1. Thin: checks
 // arrays (ValueError naming the argument), converts, releases the GIL.
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>

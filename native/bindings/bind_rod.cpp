@@ -147,7 +147,7 @@ void bind_rod(py::module_& m) {
         }
       },
       py::arg("key_directions"), py::arg("influences"), py::arg("view"),
-      "Blend weights of view keys (SEEDS.md section 2): w_i = ((dot(d_i, d) + 1) / 2)^p_i, normalised when\n"
+      "Blend weights of view keys (docs/algorithms.md §3.2): w_i = ((dot(d_i, d) + 1) / 2)^p_i, normalised when\n"
       "their sum s >= 1, w_0 = 1 - s. key_directions (m, 3) float64, influences (m,) float64 > 0, view (3,)\n"
       "float64. Returns float64 (m + 1,), w[0] (the base shape) first.");
 

@@ -1,4 +1,4 @@
-"""Fish swim: any fish mesh swims by bending along a control axis (SEEDS §1, issue 3).
+"""Fish swim: any fish mesh swims by bending along a control axis (docs/algorithms.md §1, §2).
 
 Object.kodawari_swim holds the settings; runtime.py evaluates on frame changes
 into the "Kodawari Swim" shape key; ops.py adds, tunes, bakes and removes.

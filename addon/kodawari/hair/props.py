@@ -7,7 +7,7 @@ import bpy
 from . import runtime
 
 # Influence for which a view key keeps half its weight 60 degrees away:
-# ((cos 60° + 1) / 2) ** p = 0.5  ->  p = ln 0.5 / ln 0.75 ≈ 2.41 (SEEDS.md section 2).
+# ((cos 60° + 1) / 2) ** p = 0.5  ->  p = ln 0.5 / ln 0.75 ≈ 2.41 (docs/algorithms.md §3.2).
 DEFAULT_INFLUENCE = math.log(0.5) / math.log(0.75)
 
 CONDITIONS = (
