@@ -14,9 +14,6 @@ In a window the operator runs the job modally (a timer, a time budget per tick);
 headless (`blender -b`, the bpy module, scripts) the same job runs to the end at once.
 """
 
-# bl_options sets are Blender's class-attribute convention, never mutated.
-# ruff: noqa: RUF012
-
 import time
 import traceback
 

@@ -9,9 +9,6 @@ A handler runs on every frame; a broken object must not print a traceback per fr
 so the same message for the same object is said once.
 """
 
-# bl_options sets are Blender's class-attribute convention, never mutated.
-# ruff: noqa: RUF012
-
 import bpy
 
 _messages = {}  # (feature, object name) -> the message shown in the panel

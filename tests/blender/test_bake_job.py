@@ -114,7 +114,7 @@ def test_a_gait_bake_failing_midway_is_undone(empty_scene, monkeypatch):
     assert rig.animation_data.action == action
     assert fcurve_snapshot(rig) == before
     assert {pb.name: pb.rotation_mode for pb in rig.pose.bones} == modes
-    assert not [k for k in rig.keys() if k.startswith("kodawari_contact")]  # noqa: SIM118 - ID custom properties
+    assert not [k for k in rig.keys() if k.startswith("kodawari_contact")]
 
 
 def test_a_hair_bake_failing_midway_is_undone_and_not_simulated_by_the_live_handler(

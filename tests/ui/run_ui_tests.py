@@ -19,7 +19,9 @@ import bpy
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 sys.path[:0] = [os.path.join(ROOT, "blend_samples"), os.path.join(ROOT, "tests", "blender")]
-REPORT = os.environ.get("KODAWARI_UI_REPORT", os.path.join(tempfile.gettempdir(), "kodawari-ui.xml"))
+REPORT = os.environ.get(
+    "KODAWARI_UI_REPORT", os.path.join(tempfile.gettempdir(), "kodawari-ui.xml")
+)
 TIMEOUT = 60.0
 
 
@@ -97,9 +99,14 @@ def fish_scene():
 
 def fish_state(obj, cache):
     keys = obj.data.shape_keys
-    return ([m.type for m in obj.modifiers], [k.name for k in keys.key_blocks] if keys else [],
-            obj.kodawari_swim.enabled, os.path.exists(cache), os.path.exists(cache + ".part"),
-            bpy.context.scene.frame_current)
+    return (
+        [m.type for m in obj.modifiers],
+        [k.name for k in keys.key_blocks] if keys else [],
+        obj.kodawari_swim.enabled,
+        os.path.exists(cache),
+        os.path.exists(cache + ".part"),
+        bpy.context.scene.frame_current,
+    )
 
 
 def fish_bake_escape():
@@ -119,7 +126,9 @@ def fish_bake_completes():
     scene, obj = fish_scene()
     cache = os.path.join(tempfile.mkdtemp(), "tuna.pc2")
     invoke("kodawari.swim_bake", frame_start=1, frame_end=12, target="MESH_CACHE", filepath=cache)
-    yield from wait_until(lambda: any(m.type == "MESH_CACHE" for m in obj.modifiers), "the Mesh Cache modifier")
+    yield from wait_until(
+        lambda: any(m.type == "MESH_CACHE" for m in obj.modifiers), "the Mesh Cache modifier"
+    )
     assert os.path.getsize(cache) == 32 + 12 * len(obj.data.vertices) * 12
     assert_nothing_running()
 
@@ -158,8 +167,10 @@ def gait_bake_completes():
     scene, rig = gait_scene()
     invoke("kodawari.gait_bake", frame_start=1, frame_end=48)
     yield from wait_until(lambda: "kodawari_contact_LF" in rig.keys(), "the contact channels")
-    yield from wait_until(lambda: any('kodawari_contact_RH' in path for path, _ in gait_state(rig)[0]),
-                          "the last contact F-curve")
+    yield from wait_until(
+        lambda: any("kodawari_contact_RH" in path for path, _ in gait_state(rig)[0]),
+        "the last contact F-curve",
+    )
 
 
 # --- hair ----------------------------------------------------------------------
@@ -177,7 +188,11 @@ def hair_scene():
 
 def hair_state(rig):
     anim = rig.animation_data
-    return (anim.action.name if anim and anim.action else None), rig.kodawari_hair.enabled, scene_frame()
+    return (
+        (anim.action.name if anim and anim.action else None),
+        rig.kodawari_hair.enabled,
+        scene_frame(),
+    )
 
 
 def scene_frame():
@@ -222,7 +237,9 @@ def hair_bake_fails_midway():
     yield 0.2
     assert hair_state(rig) == before, (before, hair_state(rig))
     assert rig.animation_data.action == action
-    assert not any("rotation_quaternion" in c.data_path for c in action.fcurves), "bake channels left behind"
+    assert not any("rotation_quaternion" in c.data_path for c in action.fcurves), (
+        "bake channels left behind"
+    )
 
 
 def broken_fish_is_reported_once_in_the_report_area():
@@ -242,7 +259,9 @@ def broken_fish_is_reported_once_in_the_report_area():
     said = [line for line in problems.shown[shown:] if "tuna" in line]
     assert len(said) == 1 and "fin_dorsal" in said[0], problems.shown[shown:]
     try:
-        bpy.ops.kodawari.swim_bake("INVOKE_DEFAULT", frame_start=1, frame_end=50, target="SHAPE_KEYS")
+        bpy.ops.kodawari.swim_bake(
+            "INVOKE_DEFAULT", frame_start=1, frame_end=50, target="SHAPE_KEYS"
+        )
         raise AssertionError("the bake of a broken fish started")
     except RuntimeError as exc:
         assert "fin_dorsal" in str(exc) and "Traceback" not in str(exc), exc
@@ -257,29 +276,48 @@ def fish_bake_of_unsaved_file_is_refused():
         raise AssertionError("the bake of an unsaved file started")
     except RuntimeError as exc:
         assert "Save the file first" in str(exc), exc
-    assert obj.kodawari_swim.baked == "NONE" and not any(m.type == "MESH_CACHE" for m in obj.modifiers)
+    assert obj.kodawari_swim.baked == "NONE" and not any(
+        m.type == "MESH_CACHE" for m in obj.modifiers
+    )
     assert_nothing_running()
     yield 0.1
 
 
-SCENARIOS = [fish_bake_escape, fish_bake_completes, gait_bake_escape, gait_bake_completes,
-             hair_bake_escape, hair_bake_completes, hair_bake_fails_midway, fish_bake_of_unsaved_file_is_refused,
-             broken_fish_is_reported_once_in_the_report_area]
+SCENARIOS = [
+    fish_bake_escape,
+    fish_bake_completes,
+    gait_bake_escape,
+    gait_bake_completes,
+    hair_bake_escape,
+    hair_bake_completes,
+    hair_bake_fails_midway,
+    fish_bake_of_unsaved_file_is_refused,
+    broken_fish_is_reported_once_in_the_report_area,
+]
 results = []
 state = {"index": -1, "runner": None, "start": 0.0}
 
 
 def finish():
-    suite = ET.Element("testsuite", name="ui", tests=str(len(results)),
-                       failures=str(sum(1 for r in results if r[1])))
+    suite = ET.Element(
+        "testsuite",
+        name="ui",
+        tests=str(len(results)),
+        failures=str(sum(1 for r in results if r[1])),
+    )
     for name, failure, seconds in results:
-        case = ET.SubElement(suite, "testcase", classname="tests.ui", name=name, time=f"{seconds:.2f}")
+        case = ET.SubElement(
+            suite, "testcase", classname="tests.ui", name=name, time=f"{seconds:.2f}"
+        )
         if failure:
             ET.SubElement(case, "failure", message=failure.splitlines()[-1]).text = failure
     ET.ElementTree(suite).write(REPORT)
     failed = sum(1 for r in results if r[1])
     for name, failure, _seconds in results:
-        print(f"{'FAILED' if failure else 'passed'} {name} ({_seconds:.1f} s)" + (f"\n{failure}" if failure else ""))
+        print(
+            f"{'FAILED' if failure else 'passed'} {name} ({_seconds:.1f} s)"
+            + (f"\n{failure}" if failure else "")
+        )
     print(f"{len(results) - failed} passed, {failed} failed")
     sys.stdout.flush()
     os._exit(1 if failed else 0)
