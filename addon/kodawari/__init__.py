@@ -11,6 +11,14 @@ bl_info = {
 }
 
 
+def bake_all(save=True, exit_on_failure=None):
+    """Bake every creature in the open .blend and save it, for render farms (see farm.py):
+    blender -b shot.blend --python-expr 'import kodawari; kodawari.bake_all()'"""
+    from . import farm
+
+    return farm.bake_all(save=save, exit_on_failure=exit_on_failure)
+
+
 def register():
     from . import registration
 

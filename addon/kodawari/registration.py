@@ -11,7 +11,7 @@ import importlib
 
 import bpy
 
-from . import native, preferences
+from . import native, preferences, problems
 
 FEATURE_PACKAGES = ("fish", "hair", "gait")
 
@@ -41,6 +41,7 @@ def register():
     try:
         _register_class(preferences.KodawariPreferences)
         _register_class(preferences.KODAWARI_OT_native_report)
+        _register_class(problems.KODAWARI_OT_report_problem)
         if not native.available():
             # Enable anyway, tools off; say why in the preferences and the report area.
             print(f"Kodawari: {native.error()}")

@@ -18,6 +18,7 @@ CLASSES = (
     ops.KODAWARI_OT_swim_fin_find,
     ops.KODAWARI_OT_swim_flip_head,
     ops.KODAWARI_OT_swim_bake,
+    ops.KODAWARI_OT_swim_free_bake,
     panel.KODAWARI_UL_swim_fins,
     panel.KODAWARI_PT_swim,
 )

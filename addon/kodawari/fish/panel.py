@@ -2,6 +2,7 @@
 
 import bpy
 
+from .. import problems
 from . import overlay, runtime
 
 
@@ -53,8 +54,14 @@ class KODAWARI_PT_swim(bpy.types.Panel):
                 + (f": {settings.cache_path}" if settings.baked == "MESH_CACHE" else ""),
                 icon="CHECKMARK",
             )
+            layout.operator("kodawari.swim_free_bake", icon="TRASH")
             layout.operator("kodawari.swim_remove", icon="X")
             return
+        problem = problems.message(obj, "swim")
+        if problem:
+            box = layout.box()
+            box.alert = True
+            box.label(text=f"Not swimming: {problem}", icon="ERROR")
         layout.prop(settings, "preset")
         row = layout.row(align=True)
         row.prop(settings, "head_axis")

@@ -15,6 +15,7 @@ from bpy.props import (
     StringProperty,
 )
 
+from .. import cache_paths
 from . import presets
 
 HEAD_AXES = (
@@ -286,4 +287,6 @@ class KodawariSwimSettings(bpy.types.PropertyGroup):
         ],
         default="NONE",
     )
-    cache_path: StringProperty(name="Cache Path", subtype="FILE_PATH")
+    cache_path: StringProperty(
+        name="Cache Path", subtype="FILE_PATH", options=cache_paths.RELATIVE_PATH_OPTIONS
+    )

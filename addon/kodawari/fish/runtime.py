@@ -13,7 +13,7 @@ import bpy
 import mathutils
 from bpy.app.handlers import persistent
 
-from .. import bulk
+from .. import bulk, problems
 from . import path, timing
 from . import rig as rig_module
 
@@ -124,8 +124,10 @@ def refresh(obj):
     scene = bpy.context.scene
     try:
         evaluate(obj, scene)
-    except ValueError as exc:  # e.g. a fin group emptied by the user: say so, keep the last frame
-        print(f"Kodawari Swim: {obj.name}: {exc}")
+    except Exception as exc:  # noqa: BLE001 - e.g. a fin group emptied: say so, keep the last frame
+        problems.report(obj, "swim", exc)
+    else:
+        problems.clear(obj, "swim")
 
 
 def rebind(obj):
@@ -140,8 +142,10 @@ def on_frame_change(scene, depsgraph=None):
             continue
         try:
             evaluate(obj, scene)
-        except ValueError as exc:
-            print(f"Kodawari Swim: {obj.name}: {exc}")
+        except Exception as exc:  # noqa: BLE001 - one broken fish never stops the others
+            problems.report(obj, "swim", exc)
+        else:
+            problems.clear(obj, "swim")
 
 
 @persistent
@@ -156,5 +160,5 @@ def on_load(_dummy=None, *_args):
         if obj.type == "MESH" and is_live(obj):
             try:
                 evaluate(obj, scene)
-            except ValueError as exc:
-                print(f"Kodawari Swim: {obj.name}: {exc}")
+            except Exception as exc:  # noqa: BLE001 - one broken fish never stops the others
+                problems.report(obj, "swim", exc)

@@ -2,6 +2,7 @@
 
 import bpy
 
+from .. import problems
 from . import runtime
 
 
@@ -47,8 +48,10 @@ class KODAWARI_PT_hair(bpy.types.Panel):
         obj = context.object
         settings = obj.kodawari_hair
         rt = runtime.get(obj, build=False)
-        if rt is not None and (rt.error or rt.status):
-            layout.label(text=rt.error or rt.status, icon="ERROR")
+        problem = (rt.error or rt.status) if rt is not None else ""
+        problem = problem or problems.message(obj, "hair")
+        if problem:
+            layout.label(text=problem, icon="ERROR")
         row = layout.row()
         row.template_list("KODAWARI_UL_hair_rods", "", settings, "rods", settings, "active_rod", rows=3)
         col = row.column(align=True)
