@@ -138,9 +138,15 @@ class KodawariSwimSettings(bpy.types.PropertyGroup):
     """The fish swim deformer of one mesh object."""
 
     enabled: BoolProperty(
-        name="Enabled",
-        description="Evaluate the swim on frame changes",
+        name="Show in Viewport",
+        description="Show the swim in the viewport (off: the fish keeps its rest shape there)",
         default=False,
+        update=_refresh,
+    )
+    show_render: BoolProperty(
+        name="Show in Render",
+        description="Use the swim when rendering (off: the fish renders in its rest shape)",
+        default=True,
         update=_refresh,
     )
     preset: EnumProperty(

@@ -1,0 +1,29 @@
+"""Translations of every Kodawari UI string (labels, tooltips, reports), registered
+through bpy.app.translations. Blender looks labels up in the default context ("*"),
+operator names in the "Operator" context, so each entry is registered in both.
+
+To see which strings still lack a translation: tools/i18n_missing.py."""
+
+import bpy
+
+from . import ja
+
+LANGUAGES = {"ja_JP": ja.STRINGS}
+CONTEXTS = ("*", "Operator")
+
+
+def dictionary():
+    return {locale: {(context, msgid): text for msgid, text in strings.items() for context in CONTEXTS}
+            for locale, strings in LANGUAGES.items()}
+
+
+def register():
+    unregister()
+    bpy.app.translations.register(__name__, dictionary())
+
+
+def unregister():
+    try:
+        bpy.app.translations.unregister(__name__)
+    except (ValueError, RuntimeError):
+        pass  # not registered

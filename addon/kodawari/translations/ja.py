@@ -1,0 +1,4 @@
+"""Japanese (日本語): English message -> translation."""
+
+STRINGS = {
+}
