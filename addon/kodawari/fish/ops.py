@@ -38,9 +38,11 @@ class KODAWARI_OT_swim_add(bpy.types.Operator):
         name="Head Axis",
         items=[("AUTO", "Auto", "Guess from the shape (reported)")] + list(HEAD_AXES),
         default="AUTO",
+        description="Which way the head points (Auto: guessed from the shape)",
     )
     preset: EnumProperty(
-        name="Preset", items=[(k, *presets.LABELS[k]) for k in presets.ORDER], default="CARANGIFORM"
+        name="Preset", items=[(k, *presets.LABELS[k]) for k in presets.ORDER], default="CARANGIFORM",
+        description="A kind of swimmer: sets the body wave and the fins' motions",
     )
     frequency: FloatProperty(
         name="Frequency", description="Tail beats per second (0: the preset's)", default=0.0
@@ -222,7 +224,7 @@ class KODAWARI_OT_swim_fin_add(bpy.types.Operator):
     bl_options = {"REGISTER", "UNDO"}
 
     vertex_group: StringProperty(name="Vertex Group", description="The fin's vertices")
-    kind: EnumProperty(name="Kind", items=_fin_kind_items(), default="PECTORAL")
+    kind: EnumProperty(name="Kind", items=_fin_kind_items(), default="PECTORAL", description="Which fin this is")
 
     def invoke(self, context, event):
         obj = _active_mesh(context)
@@ -352,6 +354,7 @@ class KODAWARI_OT_swim_bake(bpy.types.Operator):
             ("SHAPE_KEYS", "Shape Keys", "One shape key per frame, keyed on at its frame"),
         ],
         default="MESH_CACHE",
+        description="Where the baked swim goes",
     )
     filepath: StringProperty(
         name="File", description="PC2 file (empty: beside the .blend)", subtype="FILE_PATH"

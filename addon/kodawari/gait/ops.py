@@ -76,8 +76,8 @@ class KODAWARI_OT_gait_bake(bpy.types.Operator):
     bl_label = "Bake Gait"
     bl_options = {"REGISTER", "UNDO"}
 
-    frame_start: bpy.props.IntProperty(name="Start", default=1)
-    frame_end: bpy.props.IntProperty(name="End", default=250)
+    frame_start: bpy.props.IntProperty(name="Start", default=1, description="First frame to bake")
+    frame_end: bpy.props.IntProperty(name="End", default=250, description="Last frame to bake")
 
     def _make_job(self, context):
         try:
@@ -139,14 +139,15 @@ class KODAWARI_OT_gait_bake(bpy.types.Operator):
 
 
 class KODAWARI_OT_gait_report(bpy.types.Operator):
-    """Measure the baked gait: footfall diagram and fore-aft foot trajectories (PNG) and
-    the seed's smoothness criteria per gait segment (JSON)"""
+    """Measure the baked gait: a footfall diagram and foot paths (picture) and how smooth
+    each stretch of the gait is (JSON)"""
 
     bl_idname = "kodawari.gait_report"
     bl_label = "Gait Report"
     bl_options = {"REGISTER", "UNDO"}
 
-    filepath: bpy.props.StringProperty(name="File Path", subtype="FILE_PATH", default="//gait_report.png")
+    filepath: bpy.props.StringProperty(name="File Path", subtype="FILE_PATH", default="//gait_report.png",
+                                        description="Where to write the report")
 
     def execute(self, context):
         obj = _armature(context)
