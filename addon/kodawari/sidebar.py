@@ -65,7 +65,7 @@ def _draw_hair(layout, obj):
     settings = obj.kodawari_hair
     col = _heading(layout, "Hair", "STRANDS")
     col.prop(settings, "enabled", text="Live Simulation")
-    col.label(text=_count(len(settings.rods), "rod", "rods"))
+    col.label(text=_count(len(settings.rods), "1 rod", "{} rods"), translate=False)
     col.operator("kodawari.rod_bake", text="Bake", icon="REC")
 
 
@@ -82,7 +82,7 @@ def _draw_gait(layout, obj):
 def _count(n, one, many):
     from bpy.app.translations import pgettext_iface as iface_
 
-    return iface_("1 " + one) if n == 1 else iface_("{} " + many).format(n)
+    return iface_(one) if n == 1 else iface_(many).format(n)
 
 
 CLASSES = (KODAWARI_PT_sidebar,)

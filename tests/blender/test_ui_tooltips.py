@@ -5,8 +5,6 @@ so a setting added later without a tooltip fails here."""
 
 import re
 
-import bpy
-
 
 def _strings():
     from kodawari.translations import strings

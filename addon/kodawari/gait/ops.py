@@ -17,8 +17,7 @@ def _armature(context):
 
 
 class KODAWARI_OT_gait_setup(bpy.types.Operator):
-    """Find the four legs (by name, or from four selected foot bones) and the body bone,
-    and fill the gait settings with horse defaults"""
+    """Find the four legs (by name, or from four selected feet) and the body bone, and fill in horse settings"""
 
     bl_idname = "kodawari.gait_setup"
     bl_label = "Gait Setup"
@@ -139,8 +138,7 @@ class KODAWARI_OT_gait_bake(bpy.types.Operator):
 
 
 class KODAWARI_OT_gait_report(bpy.types.Operator):
-    """Measure the baked gait: a footfall diagram and foot paths (picture) and how smooth
-    each stretch of the gait is (JSON)"""
+    """Measure the baked gait: footfalls and foot paths (picture) and how smooth each stretch is (JSON)"""
 
     bl_idname = "kodawari.gait_report"
     bl_label = "Gait Report"

@@ -15,14 +15,14 @@ CONDITION_ICONS = {"VIEW": "CAMERA_DATA", "POSE": "ARMATURE_DATA", "SPEED": "FOR
 
 
 def _count(n, one, many):
-    return iface_(f"1 {one}") if n == 1 else iface_("{} " + many).format(n)
+    return iface_(one) if n == 1 else iface_(many).format(n)
 
 
 class KODAWARI_UL_hair_rods(bpy.types.UIList):
     def draw_item(self, context, layout, data, item, icon, active_data, active_propname, index=0):
         row = layout.row()
         row.label(text=item.root_bone or iface_("(no bone)"), icon="BONE_DATA", translate=False)
-        row.label(text=_count(len(item.keys), "key", "keys"), translate=False)
+        row.label(text=_count(len(item.keys), "1 key", "{} keys"), translate=False)
 
 
 class KODAWARI_UL_hair_keys(bpy.types.UIList):

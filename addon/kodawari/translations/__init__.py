@@ -17,6 +17,20 @@ def dictionary():
             for locale, strings in LANGUAGES.items()}
 
 
+def msgids():
+    """Every UI string of the registered add-on that needs a translation."""
+    from . import drawn, strings
+
+    found = {s.text for s in strings.registered() if s.text.strip()}
+    found |= drawn.strings()
+    return {text for text in found if any(c.isalpha() for c in text)}
+
+
+def missing(locale):
+    table = LANGUAGES.get(locale, {})
+    return sorted(text for text in msgids() if text not in table)
+
+
 def register():
     unregister()
     bpy.app.translations.register(__name__, dictionary())

@@ -1,0 +1,44 @@
+"""The literal texts the add-on's panels, menus and sidebar draw (text="..." arguments,
+labels, iface_("...") calls), read from their source with ast so the translation check
+sees strings added to a draw() later without running it."""
+
+import ast
+import os
+
+PACKAGE = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+UI_FILES = ("menus.py", "sidebar.py", "fish/panel.py", "hair/panel.py", "gait/panel.py")
+TEXT_CALLS = {"iface_", "pgettext_iface", "pgettext", "tip_", "_count"}
+
+
+def _literals(tree):
+    for node in ast.walk(tree):
+        if not isinstance(node, ast.Call):
+            continue
+        for keyword in node.keywords:
+            if keyword.arg == "text" and isinstance(keyword.value, ast.Constant) and keyword.value.value:
+                yield keyword.value.value
+        name = getattr(node.func, "id", None) or getattr(node.func, "attr", None)
+        if name in TEXT_CALLS:
+            for arg in node.args:
+                if isinstance(arg, ast.Constant) and isinstance(arg.value, str) and arg.value:
+                    yield arg.value
+        if name in ("label", "operator", "prop", "menu") or name in TEXT_CALLS:
+            continue
+    # Dictionaries of labels (e.g. LEG_LABELS) are drawn as panel titles: their str values count.
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Assign) and isinstance(node.value, ast.Dict):
+            target = getattr(node.targets[0], "id", "")
+            if target.endswith("LABELS"):
+                for value in node.value.values:
+                    if isinstance(value, ast.Constant) and isinstance(value.value, str):
+                        yield value.value
+
+
+def strings():
+    found = set()
+    for name in UI_FILES:
+        path = os.path.join(PACKAGE, name)
+        if os.path.exists(path):
+            with open(path, encoding="utf-8") as source:
+                found |= set(_literals(ast.parse(source.read())))
+    return found
