@@ -47,12 +47,12 @@ class RecordingLayout:
     """Duck-types UILayout: checks names, records what would be drawn."""
 
     def __init__(self, log, split=False, in_list=False):
-        self.__dict__.update(log=log, split=split, in_list=in_list)
+        self.__dict__.update(log=log, _split=split, in_list=in_list)
 
     def __setattr__(self, name, value):
         assert name in UILAYOUT_PROPERTIES, f"UILayout has no attribute {name!r} in this Blender"
         if name == "use_property_split":
-            self.__dict__["split"] = bool(value)
+            self.__dict__["_split"] = bool(value)
 
     def __getattr__(self, name):
         assert name in UILAYOUT_FUNCTIONS, f"UILayout has no function {name!r} in this Blender"
@@ -61,12 +61,12 @@ class RecordingLayout:
     def _record(self, kind, name, kwargs):
         icon = kwargs.get("icon")
         assert icon is None or icon in ICONS, f"no icon {icon!r} in this Blender"
-        entry = Entry(kind, name, self.split, self.in_list, kwargs)
+        entry = Entry(kind, name, self._split, self.in_list, kwargs)
         self.log.append(entry)
         return entry
 
     def _child(self):
-        return RecordingLayout(self.log, self.split, self.in_list)
+        return RecordingLayout(self.log, self._split, self.in_list)
 
     def _generic(self, name, args, kwargs):
         self._record(name, "", kwargs)

@@ -22,9 +22,9 @@ class KODAWARI_UL_swim_fins(bpy.types.UIList):
     def draw_item(self, context, layout, data, item, icon, active_data, active_propname, index):
         row = layout.row(align=True)
         row.prop(item, "enabled", text="")
-        row.label(text=item.vertex_group or iface_("(no group)"), icon="GROUP_VERTEX", translate=False)
-        row.prop(item, "kind", text="", emboss=False)
-        row.prop(item, "motion", text="", emboss=False)
+        split = row.split(factor=0.6)
+        split.label(text=item.vertex_group or iface_("(no group)"), translate=False)
+        split.prop(item, "kind", text="", emboss=False)
 
 
 def _split(layout):
@@ -38,7 +38,7 @@ def _live(context):
     return in_use.swim(obj) and obj.kodawari_swim.baked == "NONE"
 
 
-def wrap(text, width=38):
+def wrap(text, width=30):
     """Lines of at most `width` characters, so a long note is not cut off at the default width."""
     lines, line = [], ""
     for word in text.split():
@@ -95,7 +95,7 @@ class KODAWARI_PT_swim(_SwimPanel, bpy.types.Panel):
                 col.label(text=settings.cache_path, icon="FILE_CACHE", translate=False)
             layout.operator("kodawari.swim_remove", icon="X")
             return
-        layout.label(text="Runs first, before the modifiers below", icon="SORT_ASC")
+        layout.label(text="Runs before all modifiers", icon="SORT_ASC")
         col = layout.column()
         col.prop(settings, "preset")
         row = col.row(align=True)
@@ -109,12 +109,11 @@ class KODAWARI_PT_swim(_SwimPanel, bpy.types.Panel):
         col.prop(settings, "frequency")
         col.prop(settings, "amplitude", slider=True)
         col.prop(settings, "wavelength")
-        row = layout.row()
-        row.prop(settings, "bend", expand=True)
+        col.prop(settings, "bend")
         layout.separator()
-        row = layout.row(align=True)
-        row.operator("kodawari.swim_bake", text="Bake to Mesh Cache", icon="FILE_CACHE").target = "MESH_CACHE"
-        row.operator("kodawari.swim_bake", text="Bake to Shape Keys", icon="SHAPEKEY_DATA").target = "SHAPE_KEYS"
+        col = layout.column(align=True)
+        col.operator("kodawari.swim_bake", text="Bake to Mesh Cache", icon="FILE_CACHE").target = "MESH_CACHE"
+        col.operator("kodawari.swim_bake", text="Bake to Shape Keys", icon="SHAPEKEY_DATA").target = "SHAPE_KEYS"
         row = layout.row(align=True)
         row.operator("kodawari.swim_apply", text="Apply", icon="CHECKMARK")
         row.operator("kodawari.swim_remove", text="Remove", icon="X")

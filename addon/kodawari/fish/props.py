@@ -97,7 +97,7 @@ class KodawariSwimFin(bpy.types.PropertyGroup):
         update=_refresh,
     )
     frequency_ratio: FloatProperty(
-        name="Frequency Ratio",
+        name="Beat Ratio",
         description="Fin beats per tail beat (1: same frequency as the body)",
         default=1.0,
         min=0.0,
@@ -196,6 +196,7 @@ class KodawariSwimSettings(bpy.types.PropertyGroup):
         name="Amplitude",
         description="How far the tail tip swings to each side, as a share of the body length",
         subtype="FACTOR",
+        precision=3,
         default=0.1,
         min=0.0,
         soft_max=0.3,
@@ -206,6 +207,7 @@ class KodawariSwimSettings(bpy.types.PropertyGroup):
         name="Head Amplitude",
         description="How far the snout swings to each side, as a share of the body length",
         subtype="FACTOR",
+        precision=3,
         default=0.01,
         min=0.0,
         soft_max=0.3,

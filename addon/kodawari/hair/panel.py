@@ -106,7 +106,7 @@ class KODAWARI_PT_hair_rod(_HairPanel, bpy.types.Panel):
         obj = context.object
         rod = _active_rod(obj.kodawari_hair)
         col = layout.column()
-        col.prop_search(rod, "reference_bone", obj.data, "bones")
+        col.prop_search(rod, "reference_bone", obj.data, "bones", text="Reference")
         col = layout.column()
         col.prop(rod, "stiffness", slider=True)
         col.prop(rod, "damping")
@@ -143,7 +143,6 @@ class KODAWARI_PT_hair_keys(_HairPanel, bpy.types.Panel):
     def draw(self, context):
         layout = self.layout
         rod = _active_rod(context.object.kodawari_hair)
-        layout.label(text="Shapes, weighted live by the current view")
         row = layout.row()
         row.template_list("KODAWARI_UL_hair_keys", "", rod, "keys", rod, "active_key", rows=3)
         col = row.column(align=True)
@@ -159,7 +158,7 @@ class KODAWARI_PT_hair_keys(_HairPanel, bpy.types.Panel):
             col.prop(key, "condition")
             col.prop(key, "influence")
             if key.condition == "VIEW":
-                col.prop(key, "direction", text="View Direction")
+                col.prop(key, "direction", text="Direction")
             elif key.condition == "SPEED":
                 col.prop(key, "speed")
 
