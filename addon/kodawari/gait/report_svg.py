@@ -23,7 +23,7 @@ ROW_ORDER = (2, 0, 1, 3)  # LH, LF, RF, RH: the Hildebrand order
 WIDTH, LEFT, RIGHT = 1000, 110, 30
 FOOT_TOP, ROW_H = 84, 24
 TRAJ_TOP, TRAJ_H = 264, 260
-HEIGHT = TRAJ_TOP + TRAJ_H + 110
+HEIGHT = TRAJ_TOP + TRAJ_H + 135
 
 
 def _ticks(span, target=8):
@@ -132,6 +132,12 @@ def render(data, fps, title="Gait report"):
     x += 240
     out.append(f'<rect x="{x}" y="{y - 11}" width="26" height="10" fill="#1a1a1a"/>')
     out.append(_text(x + 32, y, "Planted", size=12))
+    # The gait bands' colours (a short segment has no room for its name).
+    y, x = HEIGHT - 55, LEFT
+    for g in sorted({g for g, _, _ in metrics.segments(gait)}):
+        out.append(f'<rect x="{x}" y="{y - 11}" width="26" height="12" fill="{GAIT_FILLS[g]}" stroke="#999"/>')
+        out.append(_text(x + 32, y, GAIT_NAMES[metrics.GAITS[g]], size=12))
+        x += 120
     out.append("</svg>")
     return "\n".join(out) + "\n"
 
