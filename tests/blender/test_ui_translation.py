@@ -81,3 +81,10 @@ def test_tooltips_translate(japanese):
 
     description = KodawariSwimSettings.bl_rna.properties["frequency"].description
     assert pgettext_tip(description) == "1秒あたりの尾の振り回数"
+
+
+def test_reports_translate(empty_scene, japanese):
+    """An operator's message in the report area is in Japanese too (Apply Fish Swim's refusal)."""
+    make_fish("tuna")
+    with pytest.raises(RuntimeError, match="適用する魚の泳ぎがありません"):
+        bpy.ops.kodawari.swim_apply()

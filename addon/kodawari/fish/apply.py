@@ -4,6 +4,7 @@ frame becomes its mesh and the swim is removed (one undo step takes it back)."""
 # ruff: noqa: RUF012
 
 import bpy
+from bpy.app.translations import pgettext_tip as tip_
 
 from .. import bulk
 from . import ops, runtime
@@ -25,30 +26,30 @@ class KODAWARI_OT_swim_apply(bpy.types.Operator):
         try:
             positions = runtime.evaluate(obj, context.scene).copy()
         except ValueError as exc:
-            self.report({"ERROR"}, f"Cannot apply the swim of '{obj.name}': {exc}")
+            self.report({"ERROR"}, tip_("Cannot apply the swim of '{}': {}").format(obj.name, exc))
             return {"CANCELLED"}
         with runtime.batch(obj):
             ops.remove_swim(obj)
         bulk.set_vertex_positions(obj.data, positions)
         obj.data.update()
-        self.report({"INFO"}, f"Fish Swim applied to '{obj.name}': frame {context.scene.frame_current}'s shape "
-                              "is now its mesh")
+        self.report({"INFO"}, tip_("Fish Swim applied to '{}': the shape at frame {} is now its mesh").format(
+            obj.name, context.scene.frame_current))
         return {"FINISHED"}
 
 
 def _refusal(obj):
     if obj is None or obj.type != "MESH":
-        return "Select the swimming mesh object first"
+        return tip_("Select the swimming mesh object first")
     settings = obj.kodawari_swim
     if settings.baked != "NONE":
-        return f"'{obj.name}' is baked: remove or free the bake before applying the swim"
+        return tip_("'{}' is baked: remove or free the bake before applying the swim").format(obj.name)
     if runtime.swim_key_block(obj) is None:
-        return f"'{obj.name}' has no Fish Swim to apply"
+        return tip_("'{}' has no Fish Swim to apply").format(obj.name)
     keys = obj.data.shape_keys
     others = [b.name for b in keys.key_blocks if b.name != runtime.SHAPE_KEY and b != keys.reference_key]
     if others:
-        return (f"Cannot apply to a mesh with other shape keys ({', '.join(others)}): apply or remove them "
-                "first, as for any modifier")
+        return tip_("Cannot apply to a mesh with other shape keys ({}): apply or remove them first, "
+                    "as for any modifier").format(", ".join(others))
     return None
 
 

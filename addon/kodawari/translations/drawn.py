@@ -1,12 +1,15 @@
 """The literal texts the add-on's panels, menus and sidebar draw (text="..." arguments,
-labels, iface_("...") calls), read from their source with ast so the translation check
-sees strings added to a draw() later without running it."""
+labels, iface_("...") calls) and the reports wrapped in tip_("..."), read from their
+source with ast so the translation check sees strings added later without running them.
+
+Reports are translated only where the operator wraps its message in tip_() with
+str.format placeholders (an f-string has no fixed text to look up): fish/apply.py."""
 
 import ast
 import os
 
 PACKAGE = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-UI_FILES = ("menus.py", "sidebar.py", "fish/panel.py", "hair/panel.py", "gait/panel.py")
+UI_FILES = ("menus.py", "sidebar.py", "fish/panel.py", "hair/panel.py", "gait/panel.py", "fish/apply.py")
 TEXT_CALLS = {"iface_", "pgettext_iface", "pgettext", "tip_", "_count"}
 
 
@@ -22,8 +25,6 @@ def _literals(tree):
             for arg in node.args:
                 if isinstance(arg, ast.Constant) and isinstance(arg.value, str) and arg.value:
                     yield arg.value
-        if name in ("label", "operator", "prop", "menu") or name in TEXT_CALLS:
-            continue
     # Dictionaries of labels (e.g. LEG_LABELS) are drawn as panel titles: their str values count.
     for node in ast.walk(tree):
         if isinstance(node, ast.Assign) and isinstance(node.value, ast.Dict):

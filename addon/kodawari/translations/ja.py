@@ -407,4 +407,11 @@ STRINGS = {
     "Auto by Froude number: the fastest speed, relative to leg length, at which this gait is chosen": "フルード数による自動：この歩容が選ばれる、脚の長さに対する最も速い速度",
     "In Auto": "自動で使用",
     "Auto may choose this gait": "自動選択でこの歩容を使えます",
+    # Reports (operators that wrap their messages in tip_())
+    "Cannot apply the swim of '{}': {}": "'{}' の泳ぎを適用できません：{}",
+    "Fish Swim applied to '{}': the shape at frame {} is now its mesh": "'{}' に魚の泳ぎを適用しました：フレーム {} の形状がメッシュになりました",
+    "Select the swimming mesh object first": "先に泳いでいるメッシュオブジェクトを選択してください",
+    "'{}' is baked: remove or free the bake before applying the swim": "'{}' はベイク済みです：泳ぎを適用する前にベイクを削除または解放してください",
+    "'{}' has no Fish Swim to apply": "'{}' には適用する魚の泳ぎがありません",
+    "Cannot apply to a mesh with other shape keys ({}): apply or remove them first, as for any modifier": "他のシェイプキー（{}）があるメッシュには適用できません：モディファイアーと同様、先に適用または削除してください",
 }
