@@ -28,6 +28,8 @@ def main(argv):
     for msgid in missing:
         print(json.dumps(msgid, ensure_ascii=False))
     print(f"{len(missing)} string(s) without a {locale} translation", file=sys.stderr)
+    for msgid in translations.unused(locale):
+        print(f"unused entry (safe to delete): {json.dumps(msgid, ensure_ascii=False)}", file=sys.stderr)
     return 1 if missing else 0
 
 

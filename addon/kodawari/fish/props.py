@@ -169,7 +169,7 @@ class KodawariSwimSettings(bpy.types.PropertyGroup):
         description="Object axis the head points along",
     )
     control_points: IntProperty(
-        name="Control Points",
+        name="Axis Points",
         description="How many points bend the body: more follow a long body's wave more closely",
         default=8,
         min=4,
@@ -204,7 +204,7 @@ class KodawariSwimSettings(bpy.types.PropertyGroup):
         update=_refresh,
     )
     amplitude_head: FloatProperty(
-        name="Head Amplitude",
+        name="Snout Swing",
         description="How far the snout swings to each side, as a share of the body length",
         subtype="FACTOR",
         precision=3,
@@ -215,7 +215,7 @@ class KodawariSwimSettings(bpy.types.PropertyGroup):
         update=_refresh,
     )
     envelope_start: FloatProperty(
-        name="Envelope Start",
+        name="Swing Starts",
         description="Where along the body, from the snout, the swing starts to grow toward the tail",
         default=0.45,
         min=0.0,
@@ -224,7 +224,7 @@ class KodawariSwimSettings(bpy.types.PropertyGroup):
         update=_refresh,
     )
     envelope_power: FloatProperty(
-        name="Envelope Power",
+        name="Swing Ramp",
         description="How the swing grows toward the tail: 1 evenly, higher keeps it near the tail",
         default=1.6,
         min=0.1,
@@ -248,7 +248,7 @@ class KodawariSwimSettings(bpy.types.PropertyGroup):
         update=_refresh,
     )
     phase_offset: FloatProperty(
-        name="Phase Offset",
+        name="Time Shift",
         description="Shifts the wave in time, so fish in a school do not swim in step",
         subtype="ANGLE",
         default=0.0,

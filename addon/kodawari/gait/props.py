@@ -37,9 +37,9 @@ class KodawariGaitEntry(bpy.types.PropertyGroup):
     name: bpy.props.StringProperty(name="Gait", description="Which gait this row is")
     duty_factor: bpy.props.FloatProperty(name="Duty Factor", description="Share of a stride each foot is on the ground", subtype="FACTOR",
                                          default=0.5, min=0.05, max=0.95)
-    phase_fore_hind: bpy.props.FloatProperty(name="Fore-Hind Phase", description="How long after the left hind foot the "
+    phase_fore_hind: bpy.props.FloatProperty(name="Fore-Hind", description="How long after the left hind foot the "
                                              "left fore foot lifts, as a share of a stride", subtype="FACTOR", default=0.5, min=0.0, max=1.0)
-    phase_left_right: bpy.props.FloatProperty(name="Left-Right Phase", description="How long after the left hind foot "
+    phase_left_right: bpy.props.FloatProperty(name="Left-Right", description="How long after the left hind foot "
                                                "the right hind foot lifts, as a share of a stride", subtype="FACTOR", default=0.5, min=0.0, max=1.0)
     swing_time: bpy.props.FloatProperty(name="Swing Time", description="Seconds a foot is in the air",
                                         default=0.3, min=0.05, max=5.0, unit="TIME_ABSOLUTE")
@@ -49,7 +49,7 @@ class KodawariGaitEntry(bpy.types.PropertyGroup):
                                         default=0.4, min=0.05, max=0.95)
     bob: bpy.props.FloatProperty(name="Body Bob", description="How far the body dips", default=0.03, min=0.0, subtype="DISTANCE",
                                  unit="LENGTH")
-    bobs_per_cycle: bpy.props.FloatProperty(name="Bobs per Stride", default=2.0, min=0.0, max=8.0,
+    bobs_per_cycle: bpy.props.FloatProperty(name="Bob Count", default=2.0, min=0.0, max=8.0,
                                             description="How many times the body dips in one stride")
     speed_max: bpy.props.FloatProperty(name="Top Speed", description="Auto: the fastest speed at which this gait is chosen",
                                        default=2.0, min=0.0, unit="VELOCITY")
@@ -75,7 +75,7 @@ class KodawariGaitSettings(bpy.types.PropertyGroup):
                                    min=0.05, max=1.0)
     legs: bpy.props.CollectionProperty(type=KodawariGaitLeg, name="Legs", description="The four legs Gait Setup found")
     body_bone: bpy.props.StringProperty(name="Body Bone", description="The bone that carries the animal forward (the legs' common parent)")
-    ccd_iterations: bpy.props.IntProperty(name="Solver Iterations", default=64, min=1, max=1000,
+    ccd_iterations: bpy.props.IntProperty(name="Iterations", default=64, min=1, max=1000,
                                           description="How hard each leg tries to reach its foot target")
     acceleration: bpy.props.FloatProperty(name="Acceleration", description="How quickly the speed may change",
                                           default=3.0, min=0.01, max=1000.0, unit="ACCELERATION")

@@ -31,6 +31,12 @@ def missing(locale):
     return sorted(text for text in msgids() if text not in table)
 
 
+def unused(locale):
+    """Entries no UI string asks for any more (renamed or removed): safe to delete."""
+    wanted = msgids()
+    return sorted(text for text in LANGUAGES.get(locale, {}) if text not in wanted)
+
+
 def register():
     unregister()
     bpy.app.translations.register(__name__, dictionary())

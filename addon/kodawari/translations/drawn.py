@@ -25,6 +25,14 @@ def _literals(tree):
             for arg in node.args:
                 if isinstance(arg, ast.Constant) and isinstance(arg.value, str) and arg.value:
                     yield arg.value
+    # Menu entries listed as (operator, icon, text, properties) in *_ITEMS tuples (menus.py).
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Assign) and getattr(node.targets[0], "id", "").endswith("_ITEMS"):
+            for item in getattr(node.value, "elts", []):
+                if isinstance(item, ast.Tuple) and len(item.elts) == 4:
+                    text = item.elts[2]
+                    if isinstance(text, ast.Constant) and isinstance(text.value, str):
+                        yield text.value
     # Dictionaries of labels (e.g. LEG_LABELS) are drawn as panel titles: their str values count.
     for node in ast.walk(tree):
         if isinstance(node, ast.Assign) and isinstance(node.value, ast.Dict):
