@@ -136,3 +136,37 @@ def test_sidebar_tab_shows_the_active_creature(empty_scene):
     entries = draw_body(panel)
     assert "prop speed" in entries and "operator kodawari.gait_bake" in entries
     assert "operator kodawari.rod_add" in entries, "the horse can be given hair from the tab"
+
+
+LABEL_ROOM = 12  # columns of text the label side of a split row shows at the default Properties width
+
+
+def _columns(text):
+    import unicodedata
+
+    return sum(2 if unicodedata.east_asian_width(c) in "WF" else 1 for c in text)
+
+
+@pytest.mark.parametrize("prefix", ["KODAWARI_PT_swim", "KODAWARI_PT_hair", "KODAWARI_PT_gait"])
+def test_split_labels_fit_the_default_width(empty_scene, prefix):
+    """Labels left of a setting are not cut off ("Referenc…"), in English or Japanese.
+    The room was measured on screenshots of the real window (blend_samples/ui_screenshots.py):
+    "Acceleration" and "Swing Height" fit, "Head Amplitude" and "Reference Bone" were cut."""
+    from kodawari.translations import ja
+
+    {"KODAWARI_PT_swim": lambda: add_swim(make_fish("tuna"), fins=("fin_pectoral",)),
+     "KODAWARI_PT_hair": lambda: _hair_rig(empty_scene),
+     "KODAWARI_PT_gait": lambda: _gait_horse(empty_scene)}[prefix]()
+    too_long = []
+    for panel in [p for p in _settings_panels(prefix) if p.poll(bpy.context)]:
+        for entry in draw_body(panel):
+            if entry.kind not in ("prop", "prop_search") or not entry.split or entry.in_list:
+                continue
+            rna = entry.kwargs["data"].bl_rna.properties[entry.name]
+            if rna.type == "BOOLEAN":
+                continue  # a checkbox's text is on the wide side
+            label = entry.kwargs.get("text", rna.name)
+            for text in (label, ja.STRINGS.get(label, "")):
+                if _columns(text) > LABEL_ROOM:
+                    too_long.append((panel.__name__, text))
+    assert not too_long, f"labels cut off at the default width: {too_long}"

@@ -384,7 +384,7 @@ STRINGS = {
     "Highest bend from the rest pose, in degrees": "レストポーズからの最大の曲げ（度）",
     "How readily this joint bends to reach the ground (a horse: low at the hip, full at the hoof)": "地面に届くためにこの関節がどれだけ曲がりやすいか（馬：腰で低く、蹄で最大）",
     "Which gait this row is": "この行の歩容",
-    "Duty Factor": "デューティー比",
+    "Duty Factor": "接地率",
     "Share of a stride each foot is on the ground": "1歩の周期のうち各足が接地している割合",
     "Fore-Hind": "前後位相",
     "How long after the left hind foot the left fore foot lifts, as a share of a stride": "左後足から左前足が離地するまでの遅れ（周期に対する割合）",
