@@ -122,3 +122,18 @@ def test_apply_refuses_with_a_clear_message(empty_scene):
     else:
         raise AssertionError("apply must refuse when the user's shape keys would be lost")
     assert obj.data.shape_keys.key_blocks.get("Kodawari Swim") is not None, "nothing changed"
+
+
+def test_a_swim_hidden_in_the_viewport_can_still_be_tuned_and_baked(empty_scene):
+    """Like a modifier with its eye off: the swim is still there to edit and bake."""
+    obj = make_fish("tuna")
+    original = rest(obj).copy()
+    add_swim(obj)
+    obj.kodawari_swim.enabled = False
+    assert bpy.ops.kodawari.swim_fin_add(vertex_group="fin_pectoral", kind="PECTORAL") == {"FINISHED"}
+    assert bpy.ops.kodawari.swim_bake(frame_start=1, frame_end=4, target="SHAPE_KEYS") == {"FINISHED"}
+    baked = [b for b in obj.data.shape_keys.key_blocks if b.name not in ("Basis", "Kodawari Swim")]
+    assert len(baked) == 4
+    positions = np.empty((len(baked[2].data), 3), dtype=np.float32)
+    baked[2].data.foreach_get("co", positions.reshape(-1))
+    assert np.abs(positions - original).max() > 1e-3, "the baked frames swim"

@@ -211,7 +211,7 @@ def add_fin(obj, group_name, kind):
 def _needs_swim(obj):
     if obj is None or obj.type != "MESH":
         return "Select the swimming mesh object first"
-    if not obj.kodawari_swim.enabled or runtime.swim_key_block(obj) is None:
+    if runtime.swim_key_block(obj) is None:  # hidden in the viewport (enabled off) still swims
         return f"'{obj.name}' does not swim yet: Add Fish Swim first"
     return None
 
