@@ -10,8 +10,9 @@ time. Conventions every bench_*.py follows:
   over ROUNDS rounds, and the 1-minute load average when the side was measured.
 - Peak memory is measured per side in its own child process (Blender + that side only, built and
   played the same way), because a process's peak resident set cannot be split between sides that
-  share it. "peak" is VmHWM; "above start" subtracts the process's resident size before the side
-  was built (Blender itself and the add-on).
+  share it. "peak" is VmHWM over the whole child (building included); "above start" is the peak
+  while playing (VmHWM reset once the side is built) minus the process's resident size before
+  the side was built (Blender itself and the add-on): what the side costs as the user plays it.
 """
 
 import json
@@ -185,4 +186,4 @@ def fmt_mem(row):
     if peak is None:
         return "      (memory n/a)"
     above = row.get("above_start_mb")
-    return f"peak {peak:7.0f} MB" + (f" ({above:6.0f} above start)" if above is not None else "")
+    return f"peak {peak:7.0f} MB" + (f" (playing: {above:6.0f} above start)" if above is not None else "")
