@@ -100,6 +100,10 @@ std::size_t add_rod(RodSystem& system, int parent_bone, int reference_bone, cons
     const int c = cond.data()[i];
     if (c < 0 || c > 2) throw py::value_error("key_conditions must be 0 (VIEW), 1 (POSE) or 2 (SPEED)");
     key.condition = static_cast<Condition>(c);
+    const std::string row = "[" + std::to_string(i) + "]";
+    if (c == 0 && !(dirs[i].norm() >= 1e-9)) throw py::value_error("key_directions" + row + ": a view key has a zero or NaN direction");
+    if (c == 1 && !(krot[i].norm() >= 1e-6)) throw py::value_error("key_rotations" + row + ": a pose key has a NaN or zero rotation");
+    if (c == 2 && !(speeds[i] >= 0)) throw py::value_error("key_speeds" + row + ": a speed key needs a speed >= 0");
     key.direction = dirs[i];
     key.rotation = krot[i];
     key.speed = speeds[i];

@@ -462,6 +462,16 @@ TARGETS = [
         examples=80,
     ),
     Target("gait_bake", _gait_bake_args, kn.gait_bake, examples=70),
+    # The dict arguments alone, each mutated more often than among the nine arguments.
+    *[
+        Target(
+            f"gait_bake:{key}",
+            lambda key=key: {key: _gait_bake_args()[key]},
+            lambda key=key, **kw: kn.gait_bake(**{**_gait_bake_args(), **kw}),
+            examples=60,
+        )
+        for key in ("ground", "rig", "table")
+    ],
     Target(
         "gait_forward_kinematics",
         lambda: {
