@@ -319,6 +319,28 @@ void bind_rod(py::module_& m) {
              const ExclusiveUse use = exclusive(self);
              self.frame_cache().clear();
            })
+      .def_property(
+          "cache_budget", [](RodSystem& self) {
+            const ExclusiveUse use = exclusive(self);
+            return self.frame_cache().budget();
+          },
+          [](RodSystem& self, std::size_t bytes) {
+            const ExclusiveUse use = exclusive(self);
+            self.frame_cache().set_budget(bytes);
+          },
+          "Bytes the frame cache may hold (0: unbounded). Over it, frames thin out to checkpoints\n"
+          "(see rod/frame_cache.hpp): recall_frame() is then False for a dropped frame, which is\n"
+          "recomputed exactly from latest_cached_frame_before() by stepping on.")
+      .def_property_readonly("cache_bytes", [](RodSystem& self) {
+                               const ExclusiveUse use = exclusive(self);
+                               return self.frame_cache().bytes();
+                             },
+                             "Bytes the frame cache holds now.")
+      .def_property_readonly("cache_checkpoint_interval", [](RodSystem& self) {
+                               const ExclusiveUse use = exclusive(self);
+                               return self.frame_cache().checkpoint_interval();
+                             },
+                             "Frames between the checkpoints kept once the budget thinned the cache.")
       .def("cached_state", [](RodSystem& self, int frame) -> py::object {
              const ExclusiveUse use = exclusive(self);
              const FrameCache::Entry* e = self.frame_cache().find(frame);
