@@ -163,6 +163,20 @@ def _cached_rod_method(name):
     return _method(make_self, name, _rod_state)
 
 
+def _set_cache_budget(budget):
+    """Sets the budget, then fills the cache past it: the thinning must keep a usable cache."""
+    system = _chain_system()
+    system.cache_budget = budget
+    out = np.tile(np.array([1.0, 0, 0, 0], np.float32), (6, 1))
+    args = _frame_args()
+    for frame in range(1, 30):
+        system.step(
+            args["bone_matrices"], np.eye(4), None, args["gravity"], frame / 24, 1 / 24, out
+        )
+        system.store_frame(frame, out)
+    return system.cache_budget, system.cache_bytes, system.cached_frames(), _rod_state(system)
+
+
 def _fin_args():
     return {
         "rest_points": np.column_stack([np.zeros(5), np.linspace(0, 0.4, 5), np.zeros(5)]),
@@ -419,6 +433,14 @@ TARGETS = [
         lambda: {"frame": 3},
         _cached_rod_method("cached_rotations"),
         examples=20,
+    ),
+    Target("RodSystem.cache_budget", lambda: {"budget": 4096}, _set_cache_budget, examples=40),
+    Target("RodSystem.cache_bytes", dict, lambda: _chain_system().cache_bytes, examples=1),
+    Target(
+        "RodSystem.cache_checkpoint_interval",
+        dict,
+        lambda: _chain_system().cache_checkpoint_interval,
+        examples=1,
     ),
     # --- gait
     Target("gait_horse_table", dict, kn.gait_horse_table, examples=1),
