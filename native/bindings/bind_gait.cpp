@@ -103,7 +103,7 @@ void bind_gait(py::module_& m) {
         "The horse defaults: {'gaits': (5, 11) float64 in GAIT_COLUMNS order, 'use_froude', 'hysteresis', 'reach'}.");
 
   m.def("gait_validate_table", [](const py::dict& table) { return validate_table(table_from(table)); },
-        "Empty string when the table is usable, else what is wrong.");
+        py::arg("table"), "Empty string when the table is usable, else what is wrong.");
 
   m.def("gait_validate_rig", [](const py::dict& rig) {
         try {
@@ -112,7 +112,7 @@ void bind_gait(py::module_& m) {
           return std::string(e.what());
         }
         return std::string();
-      }, "Empty string when the rig can be solved, else what is wrong.");
+      }, py::arg("rig"), "Empty string when the rig can be solved, else what is wrong.");
 
   m.def("gait_leg_phases", [](const py::dict& table, int gait) {
         if (gait < 0 || gait >= kGaitCount) throw py::value_error("gait must be 0..4");
@@ -120,7 +120,7 @@ void bind_gait(py::module_& m) {
         py::array_t<double> out(kLegCount);
         for (int leg = 0; leg < kLegCount; ++leg) out.mutable_data()[leg] = leg_phase(t.gaits[gait], static_cast<Gait>(gait), leg);
         return out;
-      }, "Lift-off phase of LF, RF, LH, RH relative to LH for one gait.");
+      }, py::arg("table"), py::arg("gait"), "Lift-off phase of LF, RF, LH, RH relative to LH for one gait.");
 
   m.def("gait_seed_swing_distance", [](double speed_new, double speed_old, double swing_time, double duty_factor,
                                        double since_change, double added_time) {
