@@ -122,9 +122,9 @@ void RodSystem::simulate(std::size_t r, const FrameInput& input, const std::vect
   const Vec3 gravity = world_to_armature * (input.gravity * p.gravity);
   const Real base_dt = 1 / rate;
   const Real min_length = *std::min_element(w.lengths.begin(), w.lengths.end());
-  // How far the root moves per substep: the root's segment must take that up. (The anchor's
-  // turn moves only the ghost behind the root, which the length projection does not see.)
-  const Real anchor_travel = steps > 0 ? (anchor_end - anchor_start).norm() / Real(steps) : Real(0);
+  // The root's velocity over this frame (the kinematic end of the first bone).
+  const Real frame_time = steps > 0 ? Real(steps) * base_dt : Real(1);
+  const Vec3 anchor_velocity = (anchor_end - anchor_start) / frame_time;
 
   w.orientation_terms.resize(count);
   w.orientation_quats.resize(count);
@@ -133,13 +133,15 @@ void RodSystem::simulate(std::size_t r, const FrameInput& input, const std::vect
   Vec3* x = s.x.data();
   Quat* q = s.q.data();
   for (long step = 1; step <= steps; ++step) {
-    // A joint must not travel more than kMaxTravel segments in one substep: beyond that the
-    // projections below no longer see the motion they correct (on long chains of short bones
-    // a whipping tip covers several bones per substep at the base rate). Such substeps are
-    // split; the shape-matching fraction is rescaled so the stiffness per base substep stays.
+    // No joint may move more than kMaxTravel bone lengths relative to the root in one
+    // substep: beyond that the length projection's linearisation no longer sees the motion it
+    // corrects (its corrections add up along the chain: on long chains of short bones a
+    // whipping tip outruns it at the base rate). A chain carried along whole by the root
+    // needs no split. Such substeps are split; the shape-matching fraction is rescaled so
+    // the stiffness per base substep stays.
     Real fastest = 0;
-    for (std::size_t j = 2; j < count; ++j) fastest = std::max(fastest, s.v[j].squaredNorm());
-    const Real travel = (std::sqrt(fastest) + gravity.norm() * base_dt) * base_dt + anchor_travel;
+    for (std::size_t j = 2; j < count; ++j) fastest = std::max(fastest, (s.v[j] - anchor_velocity).squaredNorm());
+    const Real travel = (std::sqrt(fastest) + gravity.norm() * base_dt) * base_dt;
     const Real split_needed = std::ceil(travel / (kMaxTravel * min_length));
     const int split = static_cast<int>(std::clamp(split_needed, Real(1), Real(kMaxSplit)));
     const Real dt = base_dt / Real(split);
