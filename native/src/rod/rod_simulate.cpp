@@ -251,9 +251,11 @@ void RodSystem::simulate(std::size_t r, const FrameInput& input, const std::vect
     // Inextensibility (docs/algorithms.md §3.3 step 3): the mass-weighted
     // projection onto the bone lengths (both ends of every segment move, momentum is kept;
     // rod/inextensibility.hpp), then the collider push-out.
-    project_chain_lengths(x + 1, n + 1, w.lengths.data(), w.inverse_mass.data(), w.projection.data());
+    const bool converged =
+        project_chain_lengths(x + 1, n + 1, w.lengths.data(), w.inverse_mass.data(), w.projection.data());
+    bool pushed = false;
     if (!colliders.empty()) {
-      for (std::size_t j = 2; j < count; ++j) push_out_of_colliders(x[j], colliders, p.radius);
+      for (std::size_t j = 2; j < count; ++j) pushed = push_out_of_colliders(x[j], colliders, p.radius) || pushed;
     }
     // What the projection left (a contact, a step it did not fully converge in) is closed
     // joint by joint from the root, each onto its bone length and out of the colliders, so
@@ -261,7 +263,7 @@ void RodSystem::simulate(std::size_t r, const FrameInput& input, const std::vect
     // "follow the leader" correction passed every correction down to the tip as velocity and
     // pumped energy into chains of ten or more bones (issue 9); here it moves joints by
     // round-off, or only in contact, where the push-out dissipates anyway.
-    for (std::size_t k = 0; k < n; ++k) {
+    for (std::size_t k = 0; k < n && (pushed || !converged); ++k) {
       Vec3& a = x[k + 1];
       Vec3& b = x[k + 2];
       for (int pass = 0; pass < 4; ++pass) {
