@@ -36,7 +36,10 @@ def make_vrm_like_rig(scene, bones=16, gap=0.012, seed=3):
         bone.roll = float(rng.uniform(-math.pi, math.pi))
         bone.parent = parent
         bone.use_connect = False
-        parent, position = bone, bone.tail + gap * direction.cross(Vector((1, 0, 0))).normalized() + gap * direction
+        parent, position = (
+            bone,
+            bone.tail + gap * direction.cross(Vector((1, 0, 0))).normalized() + gap * direction,
+        )
     bpy.ops.object.mode_set(mode="POSE")
     return obj
 
@@ -61,7 +64,10 @@ def test_an_unconnected_rolled_chain_starts_from_its_rest_pose_without_a_pop(emp
         empty_scene.frame_set(frame)
         frames.append([tuple(pb.matrix.to_quaternion()) for pb in _chain(obj)])
         if frame == 1:  # frame 1 is the rest pose itself
-            assert max(angle_deg(tuple(pb.rotation_quaternion), (1, 0, 0, 0)) for pb in _chain(obj)) < 1e-3
+            assert (
+                max(angle_deg(tuple(pb.rotation_quaternion), (1, 0, 0, 0)) for pb in _chain(obj))
+                < 1e-3
+            )
     for a, b in zip(frames, frames[1:]):
         change = max(angle_deg(qa, qb) for qa, qb in zip(a, b))
         assert change < 5.0, f"a joint turned {change:.1f} degrees in one frame with the head still"

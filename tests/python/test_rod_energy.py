@@ -53,6 +53,6 @@ def test_every_strand_at_the_defaults_comes_to_rest_from_a_horizontal_start(bone
     for _ in range(24 * 12):
         chain.step()
         tip_speeds.append(np.linalg.norm(chain.system.joint_velocities(chain.rod)[-1]))
-    settled = np.array(tip_speeds[24 * 10:])
+    settled = np.array(tip_speeds[24 * 10 :])
     assert settled.max() < 0.01, f"tip still moves at {settled.max():.3f} m/s after 10 s"
     assert max(tip_speeds) > 0.2, "the strand should swing down first"

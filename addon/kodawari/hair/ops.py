@@ -5,7 +5,7 @@ import math
 
 import bpy
 import numpy as np
-from mathutils import Quaternion, Vector
+from mathutils import Vector
 
 from . import chains, fitting, props, runtime
 
@@ -27,7 +27,9 @@ def _rod(obj, index):
         raise _Refusal("This armature has no rods: add one with Add Rod (kodawari.rod_add)")
     i = settings.active_rod if index < 0 else index
     if i >= len(settings.rods):
-        raise _Refusal(f"Rod index {i} is out of range (the armature has {len(settings.rods)} rods)")
+        raise _Refusal(
+            f"Rod index {i} is out of range (the armature has {len(settings.rods)} rods)"
+        )
     return i, settings.rods[i]
 
 
@@ -44,10 +46,15 @@ def _pose_shape(chain):
     """The chain's current pose as per-joint rotations; refuses NaN or zero quaternions."""
     shape = []
     for pb in chain:
-        q = tuple(pb.rotation_quaternion) if pb.rotation_mode == "QUATERNION" else \
-            tuple(pb.matrix_basis.to_quaternion())
+        q = (
+            tuple(pb.rotation_quaternion)
+            if pb.rotation_mode == "QUATERNION"
+            else tuple(pb.matrix_basis.to_quaternion())
+        )
         if not chains.finite_quaternions(q):
-            raise _Refusal(f"Bone '{pb.name}' has an invalid rotation (NaN or zero): fix the pose before keying")
+            raise _Refusal(
+                f"Bone '{pb.name}' has an invalid rotation (NaN or zero): fix the pose before keying"
+            )
         n = math.sqrt(sum(c * c for c in q))
         shape.append(tuple(c / n for c in q))
     return shape
@@ -131,7 +138,9 @@ class KODAWARI_OT_rod_add(_HairOperator, bpy.types.Operator):
         plans = []
         for root in roots:
             if root.parent is None:
-                raise _Refusal(f"Bone '{root.name}' has no parent to attach to: a rod hangs from a kinematic bone")
+                raise _Refusal(
+                    f"Bone '{root.name}' has no parent to attach to: a rod hangs from a kinematic bone"
+                )
             try:
                 chain = chains.chain_from(root)
             except chains.ChainError as exc:
@@ -144,7 +153,9 @@ class KODAWARI_OT_rod_add(_HairOperator, bpy.types.Operator):
         settings = obj.kodawari_hair
         for root, chain in plans:
             rod = settings.rods.add()
-            rod.root_bone = root.name  # tags the root bone with the rod's identity (props._root_changed)
+            rod.root_bone = (
+                root.name
+            )  # tags the root bone with the rod's identity (props._root_changed)
             for bone in chain:
                 pb = obj.pose.bones[bone.name]
                 if pb.rotation_mode != "QUATERNION":
@@ -186,11 +197,20 @@ class KODAWARI_OT_rod_key_view(_HairOperator, bpy.types.Operator):
     bl_label = "Key View"
     bl_options = {"REGISTER", "UNDO"}
     source: bpy.props.EnumProperty(
-        name="Source", default="CAMERA",
-        items=(("CAMERA", "Camera", "Look through the scene's active camera"),
-               ("VIEWPORT", "Viewport", "The 3D viewport's view")))
-    influence: bpy.props.FloatProperty(name="Influence", default=props.DEFAULT_INFLUENCE, min=0.01, soft_max=64.0,
-                                       description="Default: half weight 60 degrees away")
+        name="Source",
+        default="CAMERA",
+        items=(
+            ("CAMERA", "Camera", "Look through the scene's active camera"),
+            ("VIEWPORT", "Viewport", "The 3D viewport's view"),
+        ),
+    )
+    influence: bpy.props.FloatProperty(
+        name="Influence",
+        default=props.DEFAULT_INFLUENCE,
+        min=0.01,
+        soft_max=64.0,
+        description="Default: half weight 60 degrees away",
+    )
     rod_index: bpy.props.IntProperty(name="Rod", default=-1, description="-1: the active rod")
 
     def run(self, context):
@@ -214,7 +234,9 @@ def view_direction(obj, reference, eye_world):
     rotation = reference.matrix.to_quaternion()
     d = rotation.inverted() @ (eye - reference.matrix.translation)
     if d.length < 1e-6:
-        raise _Refusal(f"The camera is at the reference bone '{reference.name}': the view direction is undefined")
+        raise _Refusal(
+            f"The camera is at the reference bone '{reference.name}': the view direction is undefined"
+        )
     return d.normalized()
 
 
@@ -224,7 +246,9 @@ class KODAWARI_OT_rod_key_pose(_HairOperator, bpy.types.Operator):
     bl_idname = "kodawari.rod_key_pose"
     bl_label = "Key Pose"
     bl_options = {"REGISTER", "UNDO"}
-    influence: bpy.props.FloatProperty(name="Influence", default=props.DEFAULT_INFLUENCE, min=0.01, soft_max=64.0)
+    influence: bpy.props.FloatProperty(
+        name="Influence", default=props.DEFAULT_INFLUENCE, min=0.01, soft_max=64.0
+    )
     rod_index: bpy.props.IntProperty(name="Rod", default=-1, description="-1: the active rod")
 
     def run(self, context):
@@ -249,9 +273,16 @@ class KODAWARI_OT_rod_key_speed(_HairOperator, bpy.types.Operator):
     bl_idname = "kodawari.rod_key_speed"
     bl_label = "Key Speed"
     bl_options = {"REGISTER", "UNDO"}
-    speed: bpy.props.FloatProperty(name="Speed", default=2.0, min=0.0, unit="VELOCITY",
-                                   description="The reference bone's speed (m/s) at which this shape applies")
-    influence: bpy.props.FloatProperty(name="Influence", default=props.DEFAULT_INFLUENCE, min=0.01, soft_max=64.0)
+    speed: bpy.props.FloatProperty(
+        name="Speed",
+        default=2.0,
+        min=0.0,
+        unit="VELOCITY",
+        description="The reference bone's speed (m/s) at which this shape applies",
+    )
+    influence: bpy.props.FloatProperty(
+        name="Influence", default=props.DEFAULT_INFLUENCE, min=0.01, soft_max=64.0
+    )
     rod_index: bpy.props.IntProperty(name="Rod", default=-1, description="-1: the active rod")
 
     def run(self, context):
@@ -291,7 +322,9 @@ class KODAWARI_OT_rod_key_preview(_HairOperator, bpy.types.Operator):
         _, key = _key(rod, self.key_index)
         _, _, chain = _chain_pose_bones(obj, rod)
         if len(key.shape) != len(chain):
-            raise _Refusal(f"Key '{key.name}' has {len(key.shape)} joints, the chain has {len(chain)}: re-key it")
+            raise _Refusal(
+                f"Key '{key.name}' has {len(key.shape)} joints, the chain has {len(chain)}: re-key it"
+            )
         for pb, joint in zip(chain, key.shape):
             pb.rotation_mode = "QUATERNION"
             pb.rotation_quaternion = joint.rotation
@@ -350,7 +383,9 @@ class KODAWARI_OT_rod_collider_add(_HairOperator, bpy.types.Operator):
     bl_label = "Add Collider"
     bl_options = {"REGISTER", "UNDO"}
     bone: bpy.props.StringProperty(name="Bone", description="Empty: the active bone")
-    shape: bpy.props.EnumProperty(name="Shape", items=(("SPHERE", "Sphere", ""), ("CAPSULE", "Capsule", "")))
+    shape: bpy.props.EnumProperty(
+        name="Shape", items=(("SPHERE", "Sphere", ""), ("CAPSULE", "Capsule", ""))
+    )
     radius: bpy.props.FloatProperty(name="Radius", default=0.1, min=0.0, unit="LENGTH")
     length: bpy.props.FloatProperty(name="Length", default=0.2, min=0.0, unit="LENGTH")
     offset: bpy.props.FloatVectorProperty(name="Offset", size=3, unit="LENGTH")
@@ -359,7 +394,9 @@ class KODAWARI_OT_rod_collider_add(_HairOperator, bpy.types.Operator):
         obj = _armature(context)
         name = self.bone or (obj.data.bones.active.name if obj.data.bones.active else "")
         if not name or name not in obj.data.bones:
-            raise _Refusal(f"Bone '{name}' is not in the armature: pick the bone the collider follows")
+            raise _Refusal(
+                f"Bone '{name}' is not in the armature: pick the bone the collider follows"
+            )
         collider = obj.kodawari_hair.colliders.add()
         collider.bone, collider.shape, collider.radius = name, self.shape, self.radius
         collider.length, collider.offset = self.length, self.offset
@@ -393,9 +430,13 @@ class KODAWARI_OT_rod_fit_stroke(_HairOperator, bpy.types.Operator):
     bl_label = "Fit to Stroke"
     bl_options = {"REGISTER", "UNDO"}
     source: bpy.props.EnumProperty(
-        name="View", default="CAMERA",
-        items=(("CAMERA", "Camera", "As seen through the active camera"),
-               ("VIEWPORT", "Viewport", "As seen in the 3D viewport")))
+        name="View",
+        default="CAMERA",
+        items=(
+            ("CAMERA", "Camera", "As seen through the active camera"),
+            ("VIEWPORT", "Viewport", "As seen in the 3D viewport"),
+        ),
+    )
     rod_index: bpy.props.IntProperty(name="Rod", default=-1)
 
     def invoke(self, context, event):
@@ -411,10 +452,14 @@ class KODAWARI_OT_rod_fit_stroke(_HairOperator, bpy.types.Operator):
         parent, _, chain = _chain_pose_bones(obj, rod)
         points, origin = strokes.find_stroke(context, exclude=obj)
         if not points or len(points) < 2:
-            raise _Refusal("No stroke to fit: draw an annotation (or grease-pencil) stroke of two or more points")
+            raise _Refusal(
+                "No stroke to fit: draw an annotation (or grease-pencil) stroke of two or more points"
+            )
         eye, forward, perspective = _eye(context, self.source)
         try:
-            rotations = fitting.fit_chain_to_stroke(obj, parent, chain, points, eye, forward, perspective)
+            rotations = fitting.fit_chain_to_stroke(
+                obj, parent, chain, points, eye, forward, perspective
+            )
         except fitting.FitError as exc:
             raise _Refusal(str(exc)) from None
         for pb, q in zip(chain, rotations):
@@ -430,10 +475,17 @@ class KODAWARI_OT_rod_bake(bpy.types.Operator):
     bl_idname = "kodawari.rod_bake"
     bl_label = "Bake Hair"
     bl_options = {"REGISTER", "UNDO"}
-    frame_start: bpy.props.IntProperty(name="Start", default=-1, description="-1: the scene's start frame")
-    frame_end: bpy.props.IntProperty(name="End", default=-1, description="-1: the scene's end frame")
-    new_action: bpy.props.BoolProperty(name="New Action in NLA", default=False,
-                                       description="Bake into a new action pushed to an NLA track")
+    frame_start: bpy.props.IntProperty(
+        name="Start", default=-1, description="-1: the scene's start frame"
+    )
+    frame_end: bpy.props.IntProperty(
+        name="End", default=-1, description="-1: the scene's end frame"
+    )
+    new_action: bpy.props.BoolProperty(
+        name="New Action in NLA",
+        default=False,
+        description="Bake into a new action pushed to an NLA track",
+    )
 
     _timer = None
 
@@ -452,7 +504,9 @@ class KODAWARI_OT_rod_bake(bpy.types.Operator):
             raise _Refusal(rt.error)
         self._obj, self._scene = obj, scene
         self._start, self._end = start, end
-        self._first = min(scene.frame_start, start)  # live resets at the scene's start: so does the bake
+        self._first = min(
+            scene.frame_start, start
+        )  # live resets at the scene's start: so does the bake
         self._frame = self._first
         self._original_frame = scene.frame_current
         self._was_enabled = settings.enabled
@@ -505,14 +559,24 @@ class KODAWARI_OT_rod_bake(bpy.types.Operator):
         # The bake now plays back: the live simulation would only repeat it.
         obj.kodawari_hair.enabled = False
         self._scene.frame_set(self._original_frame)
-        self.report({"INFO"}, f"Baked {len(self._chains)} bones over frames {self._start}-{self._end} into "
-                              f"action '{action.name}'" + (" (NLA track)" if self.new_action else "")
-                              + "; live simulation turned off")
+        self.report(
+            {"INFO"},
+            f"Baked {len(self._chains)} bones over frames {self._start}-{self._end} into "
+            f"action '{action.name}'"
+            + (" (NLA track)" if self.new_action else "")
+            + "; live simulation turned off",
+        )
 
     def _write(self, fcurves, action, frames, values):
         for b, name in enumerate(self._chains):
-            fcurves.write_channels(action, self._obj, f'pose.bones["{name}"].rotation_quaternion', frames,
-                                   values[:, b, :], group=name)
+            fcurves.write_channels(
+                action,
+                self._obj,
+                f'pose.bones["{name}"].rotation_quaternion',
+                frames,
+                values[:, b, :],
+                group=name,
+            )
 
     def execute(self, context):
         try:
@@ -569,7 +633,16 @@ class KODAWARI_OT_rod_bake(bpy.types.Operator):
 
 
 CLASSES = (
-    KODAWARI_OT_rod_add, KODAWARI_OT_rod_remove, KODAWARI_OT_rod_key_view, KODAWARI_OT_rod_key_pose,
-    KODAWARI_OT_rod_key_speed, KODAWARI_OT_rod_key_preview, KODAWARI_OT_rod_rekey, KODAWARI_OT_rod_key_remove,
-    KODAWARI_OT_rod_collider_add, KODAWARI_OT_rod_collider_remove, KODAWARI_OT_rod_fit_stroke, KODAWARI_OT_rod_bake,
+    KODAWARI_OT_rod_add,
+    KODAWARI_OT_rod_remove,
+    KODAWARI_OT_rod_key_view,
+    KODAWARI_OT_rod_key_pose,
+    KODAWARI_OT_rod_key_speed,
+    KODAWARI_OT_rod_key_preview,
+    KODAWARI_OT_rod_rekey,
+    KODAWARI_OT_rod_key_remove,
+    KODAWARI_OT_rod_collider_add,
+    KODAWARI_OT_rod_collider_remove,
+    KODAWARI_OT_rod_fit_stroke,
+    KODAWARI_OT_rod_bake,
 )
