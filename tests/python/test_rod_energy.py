@@ -27,12 +27,33 @@ def kinetic_and_gravitational(chain):
     return 0.5 * float(np.sum(v * v)) + GRAVITY * float(np.sum(x[:, 2]))
 
 
-@pytest.mark.parametrize("bones", [16, 32, 64])
-def test_a_strand_without_damping_or_bending_stiffness_never_gains_energy(bones):
-    # With no bending stiffness to store energy, kinetic + gravitational energy is all there
-    # is: without damping it may only fall (the projection is dissipative). The old solver
-    # gained 292 J in one frame at 16 bones, 4871 J at 64.
-    chain = strand(bones, stiffness=0.01, damping=0.0)
+# Heavy damping on long strands still gains a little (measured: 0.002 J at 32 bones,
+# 0.33 J and 1.24 J at 64, against 70-190 J lost): not solved yet, shown as such.
+STILL_GAINS = pytest.mark.xfail(
+    strict=True, reason="heavy damping on long strands still gains energy"
+)
+CASES = [
+    pytest.param(
+        bones,
+        damping,
+        substeps,
+        marks=STILL_GAINS
+        if (bones, damping, substeps) in {(32, 20.0, 1), (64, 20.0, 1), (64, 20.0, 4)}
+        else (),
+    )
+    for bones in (16, 32, 64)
+    for damping in (0.0, 20.0)
+    for substeps in (1, 4)
+]
+
+
+@pytest.mark.parametrize(("bones", "damping", "substeps"), CASES)
+def test_a_strand_without_bending_stiffness_never_gains_energy(bones, damping, substeps):
+    # With (almost) no bending stiffness to store energy, kinetic + gravitational energy is
+    # all there is: it may only fall, with or without damping (the UI's extremes 0 and 20 1/s),
+    # at the fewest and the default substeps. The old solver gained 292 J in one frame at 16
+    # bones, 4871 J at 64.
+    chain = strand(bones, stiffness=0.01, damping=damping, substeps=substeps)
     energy = [kinetic_and_gravitational(chain)]
     for _ in range(96):
         chain.step()

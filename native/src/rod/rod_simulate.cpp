@@ -142,7 +142,13 @@ void RodSystem::simulate(std::size_t r, const FrameInput& input, const std::vect
     Real fastest = 0;
     for (std::size_t j = 2; j < count; ++j) fastest = std::max(fastest, (s.v[j] - anchor_velocity).squaredNorm());
     const Real travel = (std::sqrt(fastest) + gravity.norm() * base_dt) * base_dt;
-    const Real split_needed = std::ceil(travel / (kMaxTravel * min_length));
+    // Gravity alone drops every joint by g dt² per substep while the root holds; the
+    // projection lifts them all back through the root's bone, so that drop must stay a
+    // small part of a bone (kMaxDrop; g dt² is 1 mm at the default 96 Hz, 1.7 cm at one
+    // substep per frame).
+    const Real drop = gravity.norm() * base_dt * base_dt;
+    const Real split_needed = std::max(std::ceil(travel / (kMaxTravel * min_length)),
+                                       std::ceil(std::sqrt(drop / (kMaxDrop * min_length))));
     const int split = static_cast<int>(std::clamp(split_needed, Real(1), Real(kMaxSplit)));
     const Real dt = base_dt / Real(split);
     const Real inverse_dt = 1 / dt;
