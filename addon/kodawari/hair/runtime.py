@@ -15,7 +15,7 @@ pose it renders.
 
 import numpy as np
 
-from .. import native
+from .. import native, problems
 from . import chains
 
 # The solver state of the last evaluated frame is saved into the .blend (save_pre)
@@ -339,11 +339,21 @@ def hair_armatures(scene):
 
 def evaluate_scene(scene, depsgraph=None):
     for obj in hair_armatures(scene):
-        rt = get(obj)
+        rt = None
         try:
+            rt = get(obj)
             rt.evaluate(obj, scene, scene.frame_current, depsgraph)
         except ValueError as exc:  # e.g. a collapsed (zero-scale) armature: say why, keep the pose
-            rt.status = f"Hair not simulated: {exc}"
+            if rt is not None:
+                rt.status = f"Hair not simulated: {exc}"
+            else:
+                problems.report(obj, "hair", exc)
+        except Exception as exc:  # noqa: BLE001 - one broken rig never stops the others
+            problems.report(obj, "hair", exc)
+            if rt is not None:
+                rt.status = f"Hair not simulated: {problems.message(obj, 'hair')}"
+        else:
+            problems.clear(obj, "hair")
 
 
 def store_state(obj):
