@@ -353,7 +353,10 @@ def evaluate_scene(scene, depsgraph=None):
             if rt is not None:
                 rt.status = f"Hair not simulated: {problems.message(obj, 'hair')}"
         else:
-            problems.clear(obj, "hair")
+            if rt.error:  # a rod could not be built (its bones deleted or renamed): say so, once
+                problems.report(obj, "hair", ValueError(rt.error))
+            else:
+                problems.clear(obj, "hair")
 
 
 def store_state(obj):
