@@ -5,8 +5,13 @@ bl_info = {
     "author": "Kodawari developers",
     "version": (0, 1, 0),
     "blender": (3, 4, 0),
-    "location": "Properties > Modifiers (Fish Swim), Object Data (Hair, Gait)",
+    "location": "View3D > Sidebar > Kodawari; Object > Animation > Kodawari; Pose > Kodawari; "
+    "Properties > Modifiers (Fish Swim), Object Data (Hair), Object (Gait)",
     "description": "Fish that swim by bending their mesh, view-dependent hair, quadruped gaits",
+    # The repository has no public web home yet: these .example addresses (the reserved
+    # domain of its commit identity) mark the two places to change when it gets one.
+    "doc_url": "https://h-seed-fa26bf0c.example/kodawari#readme",
+    "tracker_url": "https://h-seed-fa26bf0c.example/kodawari/issues",
     "category": "Animation",
 }
 

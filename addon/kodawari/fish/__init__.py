@@ -6,7 +6,7 @@ into the "Kodawari Swim" shape key; ops.py adds, tunes, bakes and removes.
 
 import bpy
 
-from . import ops, panel, props, runtime
+from . import apply, ops, panel, props, runtime, visibility
 
 CLASSES = (
     props.KodawariSwimFin,
@@ -19,8 +19,8 @@ CLASSES = (
     ops.KODAWARI_OT_swim_flip_head,
     ops.KODAWARI_OT_swim_bake,
     ops.KODAWARI_OT_swim_free_bake,
-    panel.KODAWARI_UL_swim_fins,
-    panel.KODAWARI_PT_swim,
+    *apply.CLASSES,
+    *panel.CLASSES,
 )
 
 PROPERTIES = (
@@ -34,4 +34,5 @@ PROPERTIES = (
 HANDLERS = (
     ("frame_change_post", runtime.on_frame_change),
     ("load_post", runtime.on_load),
+    *visibility.HANDLERS,
 )

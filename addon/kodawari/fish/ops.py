@@ -38,9 +38,11 @@ class KODAWARI_OT_swim_add(bpy.types.Operator):
         name="Head Axis",
         items=[("AUTO", "Auto", "Guess from the shape (reported)")] + list(HEAD_AXES),
         default="AUTO",
+        description="Which way the head points (Auto: guessed from the shape)",
     )
     preset: EnumProperty(
-        name="Preset", items=[(k, *presets.LABELS[k]) for k in presets.ORDER], default="CARANGIFORM"
+        name="Preset", items=[(k, *presets.LABELS[k]) for k in presets.ORDER], default="CARANGIFORM",
+        description="A kind of swimmer: sets the body wave and the fins' motions",
     )
     frequency: FloatProperty(
         name="Frequency", description="Tail beats per second (0: the preset's)", default=0.0
@@ -217,7 +219,7 @@ def add_fin(obj, group_name, kind):
 def _needs_swim(obj):
     if obj is None or obj.type != "MESH":
         return "Select the swimming mesh object first"
-    if not obj.kodawari_swim.enabled or runtime.swim_key_block(obj) is None:
+    if runtime.swim_key_block(obj) is None:  # hidden in the viewport (enabled off) still swims
         return f"'{obj.name}' does not swim yet: Add Fish Swim first"
     return editable.why_not(obj, "change its swim")
 
@@ -230,7 +232,7 @@ class KODAWARI_OT_swim_fin_add(bpy.types.Operator):
     bl_options = {"REGISTER", "UNDO"}
 
     vertex_group: StringProperty(name="Vertex Group", description="The fin's vertices")
-    kind: EnumProperty(name="Kind", items=_fin_kind_items(), default="PECTORAL")
+    kind: EnumProperty(name="Kind", items=_fin_kind_items(), default="PECTORAL", description="Which fin this is")
 
     def invoke(self, context, event):
         obj = _active_mesh(context)
@@ -354,6 +356,7 @@ class KODAWARI_OT_swim_bake(BakeOperator, bpy.types.Operator):
             ("SHAPE_KEYS", "Shape Keys", "One shape key per frame, keyed on at its frame"),
         ],
         default="MESH_CACHE",
+        description="Where the baked swim goes",
     )
     filepath: StringProperty(
         name="File",

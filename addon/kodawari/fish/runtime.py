@@ -14,7 +14,7 @@ import mathutils
 from bpy.app.handlers import persistent
 
 from .. import bulk, problems
-from . import path, timing
+from . import path, timing, visibility
 from . import rig as rig_module
 
 SHAPE_KEY = rig_module.SHAPE_KEY
@@ -73,7 +73,7 @@ def is_live(obj):
         obj is not None
         and obj.type == "MESH"
         and obj.mode != "EDIT"
-        and obj.kodawari_swim.enabled
+        and visibility.visible(obj)
         and obj.kodawari_swim.baked == "NONE"
         and swim_key_block(obj) is not None
     )
@@ -119,6 +119,7 @@ def evaluate(obj, scene, frame=None):
 
 def refresh(obj):
     """Re-evaluate after a setting changed (no-op while batched or not live)."""
+    visibility.sync(obj)  # the viewport/render toggles may have changed
     if _key(obj) in _batch_depth or not is_live(obj):
         return
     scene = bpy.context.scene

@@ -13,7 +13,7 @@ CLASSES = (
     ops.KODAWARI_OT_gait_setup,
     ops.KODAWARI_OT_gait_bake,
     ops.KODAWARI_OT_gait_report,
-    panel.KODAWARI_PT_gait,
+    *panel.CLASSES,
 )
 
 PROPERTIES = (

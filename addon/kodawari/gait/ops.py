@@ -18,8 +18,7 @@ def _armature(context):
 
 
 class KODAWARI_OT_gait_setup(bpy.types.Operator):
-    """Find the four legs (by name, or from four selected foot bones) and the body bone,
-    and fill the gait settings with horse defaults"""
+    """Find the four legs (by name, or from four selected feet) and the body bone, and fill in horse settings"""
 
     bl_idname = "kodawari.gait_setup"
     bl_label = "Gait Setup"
@@ -94,14 +93,14 @@ class KODAWARI_OT_gait_bake(BakeOperator, bpy.types.Operator):
 
 
 class KODAWARI_OT_gait_report(bpy.types.Operator):
-    """Measure the baked gait: footfall diagram and fore-aft foot trajectories (PNG) and
-    the seed's smoothness criteria per gait segment (JSON)"""
+    """Measure the baked gait: footfalls and foot paths (picture) and how smooth each stretch is (JSON)"""
 
     bl_idname = "kodawari.gait_report"
     bl_label = "Gait Report"
     bl_options = {"REGISTER", "UNDO"}
 
-    filepath: bpy.props.StringProperty(name="File Path", subtype="FILE_PATH", default="//gait_report.png")
+    filepath: bpy.props.StringProperty(name="File Path", subtype="FILE_PATH", default="//gait_report.png",
+                                        description="Where to write the report")
 
     def execute(self, context):
         obj = _armature(context)

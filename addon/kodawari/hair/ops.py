@@ -149,7 +149,7 @@ class KODAWARI_OT_rod_add(_HairOperator, bpy.types.Operator):
         settings = obj.kodawari_hair
         for root, chain in plans:
             rod = settings.rods.add()
-            rod.root_bone = root.name
+            rod.root_bone = root.name  # tags the root bone with the rod's identity (props._root_changed)
             for bone in chain:
                 pb = obj.pose.bones[bone.name]
                 if pb.rotation_mode != "QUATERNION":
@@ -170,7 +170,7 @@ class KODAWARI_OT_rod_remove(_HairOperator, bpy.types.Operator):
     bl_idname = "kodawari.rod_remove"
     bl_label = "Remove Rod"
     bl_options = {"REGISTER", "UNDO"}
-    rod_index: bpy.props.IntProperty(name="Rod", default=-1, description="-1: the active rod")
+    rod_index: bpy.props.IntProperty(name="Rod", default=-1, description="Which rod (-1: the active one)")
 
     def run(self, context):
         obj = _armature(context)
@@ -193,10 +193,11 @@ class KODAWARI_OT_rod_key_view(_HairOperator, bpy.types.Operator):
     source: bpy.props.EnumProperty(
         name="Source", default="CAMERA",
         items=(("CAMERA", "Camera", "Look through the scene's active camera"),
-               ("VIEWPORT", "Viewport", "The 3D viewport's view")))
+               ("VIEWPORT", "Viewport", "The 3D viewport's view")),
+        description="Which view to key the shape for")
     influence: bpy.props.FloatProperty(name="Influence", default=props.DEFAULT_INFLUENCE, min=0.01, soft_max=64.0,
-                                       description="Default: half weight 60 degrees away")
-    rod_index: bpy.props.IntProperty(name="Rod", default=-1, description="-1: the active rod")
+                                       description="How narrowly the shape applies (the default: half strength 60° away)")
+    rod_index: bpy.props.IntProperty(name="Rod", default=-1, description="Which rod (-1: the active one)")
 
     def run(self, context):
         obj = _armature(context)
@@ -229,8 +230,9 @@ class KODAWARI_OT_rod_key_pose(_HairOperator, bpy.types.Operator):
     bl_idname = "kodawari.rod_key_pose"
     bl_label = "Key Pose"
     bl_options = {"REGISTER", "UNDO"}
-    influence: bpy.props.FloatProperty(name="Influence", default=props.DEFAULT_INFLUENCE, min=0.01, soft_max=64.0)
-    rod_index: bpy.props.IntProperty(name="Rod", default=-1, description="-1: the active rod")
+    influence: bpy.props.FloatProperty(name="Influence", default=props.DEFAULT_INFLUENCE, min=0.01, soft_max=64.0,
+                                       description="How narrowly the shape applies (the default: half strength 60° away)")
+    rod_index: bpy.props.IntProperty(name="Rod", default=-1, description="Which rod (-1: the active one)")
 
     def run(self, context):
         obj = _armature(context)
@@ -256,8 +258,9 @@ class KODAWARI_OT_rod_key_speed(_HairOperator, bpy.types.Operator):
     bl_options = {"REGISTER", "UNDO"}
     speed: bpy.props.FloatProperty(name="Speed", default=2.0, min=0.0, unit="VELOCITY",
                                    description="The reference bone's speed (m/s) at which this shape applies")
-    influence: bpy.props.FloatProperty(name="Influence", default=props.DEFAULT_INFLUENCE, min=0.01, soft_max=64.0)
-    rod_index: bpy.props.IntProperty(name="Rod", default=-1, description="-1: the active rod")
+    influence: bpy.props.FloatProperty(name="Influence", default=props.DEFAULT_INFLUENCE, min=0.01, soft_max=64.0,
+                                       description="How narrowly the shape applies (the default: half strength 60° away)")
+    rod_index: bpy.props.IntProperty(name="Rod", default=-1, description="Which rod (-1: the active one)")
 
     def run(self, context):
         obj = _armature(context)
@@ -287,8 +290,8 @@ class KODAWARI_OT_rod_key_preview(_HairOperator, bpy.types.Operator):
     bl_idname = "kodawari.rod_key_preview"
     bl_label = "Preview Key"
     bl_options = {"REGISTER", "UNDO"}
-    rod_index: bpy.props.IntProperty(name="Rod", default=-1)
-    key_index: bpy.props.IntProperty(name="Key", default=-1)
+    rod_index: bpy.props.IntProperty(name="Rod", default=-1, description="Which rod (-1: the active one)")
+    key_index: bpy.props.IntProperty(name="Key", default=-1, description="Which key (-1: the active one)")
 
     def run(self, context):
         obj = _armature(context)
@@ -310,8 +313,8 @@ class KODAWARI_OT_rod_rekey(_HairOperator, bpy.types.Operator):
     bl_idname = "kodawari.rod_rekey"
     bl_label = "Re-key"
     bl_options = {"REGISTER", "UNDO"}
-    rod_index: bpy.props.IntProperty(name="Rod", default=-1)
-    key_index: bpy.props.IntProperty(name="Key", default=-1)
+    rod_index: bpy.props.IntProperty(name="Rod", default=-1, description="Which rod (-1: the active one)")
+    key_index: bpy.props.IntProperty(name="Key", default=-1, description="Which key (-1: the active one)")
 
     def run(self, context):
         obj = _armature(context)
@@ -333,8 +336,8 @@ class KODAWARI_OT_rod_key_remove(_HairOperator, bpy.types.Operator):
     bl_idname = "kodawari.rod_key_remove"
     bl_label = "Delete Key"
     bl_options = {"REGISTER", "UNDO"}
-    rod_index: bpy.props.IntProperty(name="Rod", default=-1)
-    key_index: bpy.props.IntProperty(name="Key", default=-1)
+    rod_index: bpy.props.IntProperty(name="Rod", default=-1, description="Which rod (-1: the active one)")
+    key_index: bpy.props.IntProperty(name="Key", default=-1, description="Which key (-1: the active one)")
 
     def run(self, context):
         obj = _armature(context)
@@ -355,10 +358,15 @@ class KODAWARI_OT_rod_collider_add(_HairOperator, bpy.types.Operator):
     bl_label = "Add Collider"
     bl_options = {"REGISTER", "UNDO"}
     bone: bpy.props.StringProperty(name="Bone", description="Empty: the active bone")
-    shape: bpy.props.EnumProperty(name="Shape", items=(("SPHERE", "Sphere", ""), ("CAPSULE", "Capsule", "")))
-    radius: bpy.props.FloatProperty(name="Radius", default=0.1, min=0.0, unit="LENGTH")
-    length: bpy.props.FloatProperty(name="Length", default=0.2, min=0.0, unit="LENGTH")
-    offset: bpy.props.FloatVectorProperty(name="Offset", size=3, unit="LENGTH")
+    shape: bpy.props.EnumProperty(name="Shape", items=(("SPHERE", "Sphere", "A ball around a point"),
+                                                       ("CAPSULE", "Capsule", "A rounded cylinder along the bone")),
+                                  description="Shape the hair cannot enter")
+    radius: bpy.props.FloatProperty(name="Radius", default=0.1, min=0.0, unit="LENGTH", subtype="DISTANCE",
+                                    description="Size of the collider")
+    length: bpy.props.FloatProperty(name="Length", default=0.2, min=0.0, unit="LENGTH", subtype="DISTANCE",
+                                    description="Capsule: how far it reaches along the bone")
+    offset: bpy.props.FloatVectorProperty(name="Offset", size=3, unit="LENGTH", subtype="TRANSLATION",
+                                          description="Where the collider sits, relative to the bone")
 
     def run(self, context):
         obj = _armature(context)
@@ -400,8 +408,9 @@ class KODAWARI_OT_rod_fit_stroke(_HairOperator, bpy.types.Operator):
     source: bpy.props.EnumProperty(
         name="View", default="CAMERA",
         items=(("CAMERA", "Camera", "As seen through the active camera"),
-               ("VIEWPORT", "Viewport", "As seen in the 3D viewport")))
-    rod_index: bpy.props.IntProperty(name="Rod", default=-1)
+               ("VIEWPORT", "Viewport", "As seen in the 3D viewport")),
+        description="Which view the stroke was drawn in")
+    rod_index: bpy.props.IntProperty(name="Rod", default=-1, description="Which rod (-1: the active one)")
 
     def invoke(self, context, event):
         if _viewport_eye(context) is not None:
