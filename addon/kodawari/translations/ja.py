@@ -413,4 +413,15 @@ STRINGS = {
     "'{}' is baked: remove or free the bake before applying the swim": "'{}' はベイク済みです：泳ぎを適用する前にベイクを削除または解放してください",
     "'{}' has no Fish Swim to apply": "'{}' には適用する魚の泳ぎがありません",
     "Cannot apply to a mesh with other shape keys ({}): apply or remove them first, as for any modifier": "他のシェイプキー（{}）があるメッシュには適用できません：モディファイアーと同様、先に適用または削除してください",
+    # Bakes: the shared frame range, Free Bake, problem reports (bake_job.py, problems.py)
+    "First frame to bake (unset: the scene's start)": "ベイクする最初のフレーム（未設定ならシーンの開始フレーム）",
+    "Last frame to bake (unset: the scene's end)": "ベイクする最後のフレーム（未設定ならシーンの終了フレーム）",
+    "Free Bake": "ベイクを解放",
+    "Free the bake and swim live again; the setup (fins, preset, bend, timing) is kept": "ベイクを解放して再びライブで泳がせます。設定（ひれ・プリセット・曲げ・タイミング）はそのまま残ります",
+    "PC2 file (empty: in the folder blendcache_<file name> beside the .blend)": "PC2 ファイル（空なら .blend の隣の blendcache_<ファイル名> フォルダー）",
+    "Kodawari: Problem": "Kodawari: 問題",
+    "Show a creature's problem in the report area": "クリーチャーの問題をレポート領域に表示します",
+    "Message": "メッセージ",
+    "The problem to show": "表示する問題",
+    "Not swimming: {}": "泳いでいません: {}",
 }
