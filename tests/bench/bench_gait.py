@@ -3,17 +3,21 @@ end to end, F-curve writes included, then bake the same foot targets through Ble
 own IK constraints with nla.bake visual keying (fewer frames, scaled per frame), and
 print the ratio. Run in Blender by tools/run_bench.sh with the add-on installed."""
 
+import os
+import sys
 import time
 
 import bpy
 import numpy as np
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "blend_samples"))
 
 FRAMES = 10_000
 IK_FRAMES = 300
 
 
 def setup():
-    from kodawari.gait import samples
+    import gait_samples as samples
 
     bpy.ops.wm.read_homefile(use_empty=True, use_factory_startup=True)
     scene = bpy.context.scene

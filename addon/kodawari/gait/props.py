@@ -10,8 +10,12 @@ GAIT_ITEMS = (
     ("GALLOP", "Gallop", "Transverse gallop (LH, RH, LF, RF)"),
     ("GALLOP_ROTARY", "Rotary Gallop", "Rotary gallop (LH, RH, RF, LF)"),
 )
-GAIT_NAMES = tuple(item[0] for item in GAIT_ITEMS[1:])
-LEG_NAMES = ("LF", "RF", "LH", "RH")
+GAIT_NAMES = tuple(item[0] for item in GAIT_ITEMS[1:])  # the core's kodawari_native.GAIT_NAMES
+LEG_NAMES = ("LF", "RF", "LH", "RH")  # the core's kodawari_native.LEG_NAMES (checked in native.py tests)
+ROOT_MOTION_ITEMS = (
+    ("BONE", "Body Bone", "Key root motion on the body bone (the topmost bone whose location Blender applies)"),
+    ("OBJECT", "Armature Object", "Key root motion on the armature object itself"),
+)
 
 
 class KodawariGaitBone(bpy.types.PropertyGroup):
@@ -55,6 +59,10 @@ class KodawariGaitEntry(bpy.types.PropertyGroup):
     froude_max: bpy.props.FloatProperty(name="Top Froude", description="AUTO with Froude: top of the band as "
                                         "v²/(g·leg length)", default=0.35, min=0.0)
     use_in_auto: bpy.props.BoolProperty(name="In Auto", description="AUTO may choose this gait", default=True)
+    duty_factor_top: bpy.props.FloatProperty(name="Duty Factor at Top", description="Duty factor at the top of the "
+                                             "gait's speed band; it changes linearly from Duty Factor at the band's "
+                                             "bottom (gallops: the stance shortens with speed)",
+                                             default=0.5, min=0.05, max=0.95)
 
 
 class KodawariGaitSettings(bpy.types.PropertyGroup):
@@ -73,6 +81,8 @@ class KodawariGaitSettings(bpy.types.PropertyGroup):
                                    min=0.05, max=1.0)
     legs: bpy.props.CollectionProperty(type=KodawariGaitLeg)
     body_bone: bpy.props.StringProperty(name="Body Bone", description="The bone carrying root motion")
+    root_motion: bpy.props.EnumProperty(name="Root Motion", items=ROOT_MOTION_ITEMS, default="BONE",
+                                        description="Where the bake keys the animal's travel")
     ccd_iterations: bpy.props.IntProperty(name="CCD Iterations", default=64, min=1, max=1000)
     acceleration: bpy.props.FloatProperty(name="Acceleration", description="Largest change of speed, m/s²",
                                           default=3.0, min=0.01, max=1000.0)
