@@ -6,11 +6,14 @@ The head moves and the camera orbits. Two identical rigs share the spot: "plain"
 (physics only) and "kodawari" (the same physics plus the keyed view shapes); each is
 rendered alone from four camera angles. Writes out/hair.blend and out/hair_sheet.png
 (top row plain physics, bottom row view-dependent; columns front, right, back, left;
-the rows and columns are labelled on the sheet).
+the rows and columns are labelled on the sheet). Every character wears an 18-bone
+ponytail; a third one lunges and holds still while its ponytail swings and settles,
+rendered live into out/hair_swing.gif and out/hair_swing.png (six moments, 0-6 s).
 """
 
 import math
 import os
+import subprocess
 
 import bpy
 import numpy as np
@@ -33,13 +36,17 @@ CHAINS = (
     ("BangR", (0.08, -0.17, 1.9), (0.0, -0.35, -1.0), 4, 0.05),
     ("EarL", (-0.09, 0.02, 1.94), (-0.25, 0.0, 1.0), 5, 0.07),
     ("EarR", (0.09, 0.02, 1.94), (0.25, 0.0, 1.0), 5, 0.07),
+    # A ponytail of 18 short bones hanging from the back of the head (0.63 m).
+    ("Tail", (0.0, 0.235, 1.82), (0.0, 0.2, -1.0), 18, 0.035),
 )
+SWING_FRAMES = range(1, 145, 2)  # 6 s of the swing demo, every other frame (12 fps GIF)
 
 
 def material(name, color):
     mat = bpy.data.materials.new(name)
     mat.use_nodes = True
     mat.node_tree.nodes["Principled BSDF"].inputs["Base Color"].default_value = (*color, 1.0)
+    mat.diffuse_color = (*color, 1.0)  # what the Workbench (swing demo) shows
     return mat
 
 
@@ -118,7 +125,7 @@ def build_character(label, mats):
     neck.rotation_euler = (math.pi / 2, 0, 0)
     for name, _, _, count, length in CHAINS:
         mat = mats["ear"] if name.startswith("Ear") else mats["hair"]
-        radius = 0.028 if name.startswith("Ear") else (0.02 if name == "Ahoge" else 0.014)
+        radius = 0.028 if name.startswith("Ear") else (0.02 if name in ("Ahoge", "Tail") else 0.014)
         for i in range(count):
             piece = cylinder(f"{label}{name}.{i}", length, radius, mat, collection)
             parent_to_bone(piece, rig, f"{name}.{i}", keep_world=False)
@@ -131,7 +138,7 @@ def add_rods(rig):
         chains.set_selected(pb, pb.name.endswith(".0"))
     assert bpy.ops.kodawari.rod_add() == {"FINISHED"}
     for rod in rig.kodawari_hair.rods:
-        rod.stiffness = 0.9 if rod.root_bone.startswith("Ear") else 0.6
+        rod.stiffness = 0.9 if rod.root_bone.startswith("Ear") else (0.35 if rod.root_bone.startswith("Tail") else 0.6)
         rod.iterations = 6
         rod.damping = 1.5
         rod.radius = 0.012
@@ -309,6 +316,70 @@ def labelled_sheet(rows, row_labels, column_labels, header=44):
     return sheet
 
 
+def swing_demo(scene, mats, hidden):
+    """A third character whose head lunges forward and back, then holds still: its 18-bone
+    ponytail swings and comes to rest. Rendered live (no bake) from the side, every other
+    frame, into out/hair_swing.gif (ffmpeg) and the frames' strip out/hair_swing.png."""
+    for collection in hidden:
+        collection.hide_render = True
+    rig, collection = build_character("Swing", mats)
+    add_rods(rig)
+    head = rig.pose.bones["Head"]
+    head.rotation_mode = "XYZ"
+    for frame, y, tilt in ((1, 0.0, 0.0), (9, -0.35, 0.35), (18, 0.08, -0.15), (26, 0.0, 0.0)):
+        head.location = (0.0, y, 0.0)
+        head.rotation_euler = (tilt, 0.0, 0.0)
+        head.keyframe_insert("location", frame=frame)
+        head.keyframe_insert("rotation_euler", frame=frame)
+    bpy.ops.object.mode_set(mode="OBJECT")
+    rig.hide_render = True
+    camera = bpy.data.objects.new("SideCamera", bpy.data.cameras.new("SideCamera"))
+    scene.collection.objects.link(camera)
+    camera.data.type = "ORTHO"
+    camera.data.ortho_scale = 1.6
+    camera.location = (4.0, 0.05, 1.55)
+    camera.rotation_euler = (math.radians(90), 0, math.radians(90))
+    scene.camera = camera
+    scene.render.engine = "BLENDER_WORKBENCH"
+    if scene.world is None:
+        scene.world = bpy.data.worlds.new("World")
+    scene.world.color = (0.55, 0.6, 0.68)
+    scene.display.shading.light = "STUDIO"
+    scene.display.shading.color_type = "MATERIAL"
+    scene.render.resolution_x, scene.render.resolution_y = 320, 360
+    frames = []
+    for frame in SWING_FRAMES:
+        scene.frame_set(frame)  # the live handler simulates every frame in order
+        path = os.path.join(OUT, f"_swing_{len(frames):03d}.png")
+        scene.render.filepath = path
+        bpy.ops.render.render(write_still=True)
+        frames.append(path)
+    gif = os.path.join(OUT, "hair_swing.gif")
+    try:
+        subprocess.run(["ffmpeg", "-y", "-loglevel", "error", "-framerate", "12", "-i",
+                        os.path.join(OUT, "_swing_%03d.png"), "-vf",
+                        "split[a][b];[a]palettegen=max_colors=64[p];[b][p]paletteuse", gif], check=True)
+        print(f"wrote {gif}")
+    except (OSError, subprocess.CalledProcessError) as exc:
+        print(f"no GIF ({exc}): the frames are out/_swing_*.png")
+        return
+    # A strip of six moments (0, 0.5, 1, 2, 3.5, 6 s) for pages that show no GIF.
+    picks = [0, 6, 12, 24, 42, len(frames) - 1]
+    tiles = []
+    for index in picks:
+        image = bpy.data.images.load(frames[index])
+        tiles.append(np.array(image.pixels[:], dtype=np.float32).reshape(360, 320, 4))
+        bpy.data.images.remove(image)
+    strip = np.concatenate(tiles, axis=1)
+    image = bpy.data.images.new("hair_swing", strip.shape[1], strip.shape[0])
+    image.pixels[:] = strip.ravel()
+    image.filepath_raw = os.path.join(OUT, "hair_swing.png")
+    image.file_format = "PNG"
+    image.save()
+    for path in frames:
+        os.remove(path)
+
+
 def main():
     os.makedirs(OUT, exist_ok=True)
     bpy.ops.wm.read_homefile(use_empty=True)
@@ -350,6 +421,7 @@ def main():
     image.file_format = "PNG"
     image.save()
     print(f"wrote {os.path.join(OUT, 'hair.blend')} and {image.filepath_raw}")
+    swing_demo(scene, mats, (plain_collection, kodawari_collection))
 
 
 main()

@@ -1,4 +1,4 @@
-"""Fin set-up (SEEDS §1 "Fins"): a small control axis per fin, bound once.
+"""Fin set-up (docs/algorithms.md §2.4): a small control axis per fin, bound once.
 
 A fin's vertices come from a vertex group. Its axis runs root → tip with the
 first three of five control points clustered at the root (they stay fixed, so

@@ -1,8 +1,8 @@
-"""Swimming modes of the fish document (SEEDS §1) with numbers from the literature.
+"""Swimming modes of the fish document (docs/algorithms.md §2.7) with numbers from the literature.
 
 Body values are fractions of body length L; fin amplitudes are radians for FLAP,
 UP_DOWN and TWIST and, for UNDULATE, the sideways excursion as a fraction of the fin's height.
-Sources: SEEDS §1 literature notes (Bainbridge 1958; tail peak ≈ 0.1 L at cruise,
+Sources: docs/algorithms.md §2.6-§2.7 (Bainbridge 1958; tail peak ≈ 0.1 L at cruise,
 maximum ≈ L/5; Strouhal 0.25-0.3 for carangiform swimmers) and the issue's preset list.
 """
 

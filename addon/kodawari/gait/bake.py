@@ -6,6 +6,7 @@ import bpy
 import numpy as np
 
 from .. import fcurves, native
+from ..bake_job import BakeJob
 from . import rig as rigmod
 from . import runtime
 from .props import GAIT_NAMES, LEG_NAMES
@@ -120,8 +121,11 @@ def euler_xyz(q):
     return np.unwrap(np.stack([ex, ey, ez], axis=1), axis=0)
 
 
-class GaitBakeJob:
-    """validate+solve in __init__ (raises ValueError), then begin/steps/finish or cancel."""
+class GaitBakeJob(BakeJob):
+    """validate+solve in __init__ (raises ValueError), then begin/steps/finish or cancel;
+    prepare/step are the BakeJob protocol (bake_job.py) over begin/steps."""
+
+    title = "Gait bake"
 
     def __init__(self, context, obj, frame_start, frame_end):
         if obj is None or obj.type != "ARMATURE":
@@ -279,6 +283,7 @@ class GaitBakeJob:
             self.action.name = name
         runtime.remember(self.obj, self)
         self.obj.update_tag()
+        return f"Baked {len(self.frames)} frames of gait on '{self.obj.name}'"
 
     def cancel(self):
         """Put back the action, slot, rotation modes and custom properties."""
@@ -299,6 +304,14 @@ class GaitBakeJob:
             elif key in obj.keys():
                 del obj[key]
         self._started = False
+
+    # --- the BakeJob protocol ---------------------------------------------------------
+    def prepare(self):
+        self.begin()
+        self._pending = self.steps()
+
+    def step(self):
+        return next(self._pending, 1.0)
 
     def run(self):
         self.begin()

@@ -4,7 +4,8 @@ gait_report (measure the baked Action, write PNG + JSON)."""
 import bpy
 import numpy as np
 
-from .. import native
+from .. import editable, native
+from ..bake_job import BakeError, BakeOperator, frame_range
 from . import rig as rigmod
 from .bake import GaitBakeJob
 from .props import LEG_NAMES
@@ -39,6 +40,10 @@ class KODAWARI_OT_gait_setup(bpy.types.Operator):
         obj = _armature(context)
         if obj is None:
             self.report({"ERROR"}, "Gait Setup needs an armature as the active object")
+            return {"CANCELLED"}
+        why = editable.why_not(obj, "get a gait")
+        if why:
+            self.report({"ERROR"}, why)
             return {"CANCELLED"}
         try:
             why = self._setup(context, obj)
@@ -101,84 +106,34 @@ class KODAWARI_OT_gait_setup(bpy.types.Operator):
         return None
 
 
-class KODAWARI_OT_gait_bake(bpy.types.Operator):
+class KODAWARI_OT_gait_bake(BakeOperator, bpy.types.Operator):
     """Plan the gait from the speed curve, solve every leg, and bake it to an Action"""
 
     bl_idname = "kodawari.gait_bake"
     bl_label = "Bake Gait"
     bl_options = {"REGISTER", "UNDO"}
 
-    frame_start: bpy.props.IntProperty(name="Start", default=1)
-    frame_end: bpy.props.IntProperty(name="End", default=250)
-
-    def _make_job(self, context):
+    def make_job(self, context):
+        obj = _armature(context) or context.active_object
+        why = editable.why_not(obj, "bake a gait")
+        if why:
+            raise BakeError(why)
+        start, end = frame_range(self, context.scene)
         try:
-            return GaitBakeJob(context, _armature(context) or context.active_object, self.frame_start,
-                               self.frame_end)
+            return GaitBakeJob(context, obj, start, end)
         except ValueError as exc:
-            self.report({"ERROR"}, f"Gait bake: {exc}")
-            return None
-
-    def execute(self, context):
-        job = self._make_job(context)
-        if job is None:
-            return {"CANCELLED"}
-        job.run()
-        self.report({"INFO"}, f"Baked {len(job.frames)} frames of gait on '{job.obj.name}'")
-        return {"FINISHED"}
-
-    def invoke(self, context, event):
-        if not self.properties.is_property_set("frame_start"):
-            self.frame_start = context.scene.frame_start
-        if not self.properties.is_property_set("frame_end"):
-            self.frame_end = context.scene.frame_end
-        if bpy.app.background:
-            return self.execute(context)
-        self._job = self._make_job(context)
-        if self._job is None:
-            return {"CANCELLED"}
-        self._job.begin()
-        self._steps = self._job.steps()
-        wm = context.window_manager
-        wm.progress_begin(0, 100)
-        self._timer = wm.event_timer_add(0.01, window=context.window)
-        wm.modal_handler_add(self)
-        return {"RUNNING_MODAL"}
-
-    def modal(self, context, event):
-        wm = context.window_manager
-        if event.type == "ESC":
-            self._job.cancel()
-            self._end(context)
-            self.report({"WARNING"}, "Gait bake cancelled: nothing changed")
-            return {"CANCELLED"}
-        if event.type != "TIMER":
-            return {"PASS_THROUGH"}
-        try:
-            fraction = next(self._steps)
-            wm.progress_update(int(fraction * 100))
-        except StopIteration:
-            self._job.finish()
-            self._end(context)
-            self.report({"INFO"}, f"Baked {len(self._job.frames)} frames of gait on '{self._job.obj.name}'")
-            return {"FINISHED"}
-        return {"RUNNING_MODAL"}
-
-    def _end(self, context):
-        wm = context.window_manager
-        wm.event_timer_remove(self._timer)
-        wm.progress_end()
+            raise BakeError(f"Gait bake: {exc}") from None
 
 
 class KODAWARI_OT_gait_report(bpy.types.Operator):
-    """Measure the baked gait: footfall diagram and fore-aft foot trajectories (PNG) and
-    the seed's smoothness criteria per gait segment (JSON)"""
+    """Measure the baked gait: footfalls and foot paths (picture) and how smooth each stretch is (JSON)"""
 
     bl_idname = "kodawari.gait_report"
     bl_label = "Gait Report"
     bl_options = {"REGISTER", "UNDO"}
 
-    filepath: bpy.props.StringProperty(name="File Path", subtype="FILE_PATH", default="//gait_report.png")
+    filepath: bpy.props.StringProperty(name="File Path", subtype="FILE_PATH", default="//gait_report.png",
+                                        description="Where to write the report")
 
     def execute(self, context):
         obj = _armature(context)

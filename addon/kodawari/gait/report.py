@@ -9,7 +9,7 @@ import bpy
 import numpy as np
 
 from .. import fcurves
-from . import metrics
+from . import metrics, report_svg
 from . import rig as rigmod
 from .bake import CONTACT_PROPS, GAIT_PROP
 from .font import draw_text
@@ -244,5 +244,8 @@ def write_report(obj, filepath, fps):
               "segments": data["segments"]}
     with open(base + ".json", "w") as fh:
         json.dump(report, fh, indent=1)
-    save_png(draw_report(data, fps), base + ".png")
-    return base + ".png", base + ".json", data
+    save_png(draw_report(data, fps), base + ".png")  # a quick look in Blender's Image Editor
+    # The report to read and zoom: SVG with real text, axes, units and a legend.
+    data["neutral"] = rigmod.neutral_offsets(data["rig"])
+    report_svg.write(data, fps, base + ".svg", f"Gait report: {obj.name}")
+    return base + ".svg", base + ".json", data

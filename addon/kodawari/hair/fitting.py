@@ -1,4 +1,4 @@
-"""Sketch editing (SEEDS.md section 2, "Tooling described"): the chain takes the shape
+"""Sketch editing (docs/algorithms.md §3.6): the chain takes the shape
 of one stroke as seen from the current view. The stroke is projected onto the plane
 through the chain root facing the view, resampled by the bone lengths from the root,
 and each bone is turned (no twist) to point at its resampled joint."""
