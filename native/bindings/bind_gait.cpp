@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <string>
+#include <vector>
 
 #include "arrays.hpp"
 #include "bind.hpp"
@@ -18,10 +19,10 @@ namespace kodawari::bind {
 namespace {
 
 using namespace kodawari::gait;
-constexpr int kColumns = 11;
+constexpr int kColumns = 12;
 const char* kGaitColumns[kColumns] = {"duty_factor", "phase_fore_hind", "phase_left_right", "swing_time",
                                       "swing_height", "swing_peak", "bob", "bobs_per_cycle", "speed_max",
-                                      "froude_max", "use_in_auto"};
+                                      "froude_max", "use_in_auto", "duty_factor_top"};
 
 GaitTable table_from(const py::handle& table) {
   const py::dict d = dict_arg(table, "table");
@@ -41,6 +42,7 @@ GaitTable table_from(const py::handle& table) {
     p.speed_max = r[8];
     p.froude_max = r[9];
     p.use_in_auto = r[10] != 0;
+    p.duty_factor_top = r[11];
   }
   t.use_froude = bool_item(d, "use_froude", "table");
   t.hysteresis = number_item(d, "hysteresis", "table");
@@ -54,7 +56,7 @@ py::dict table_to(const GaitTable& t) {
     const GaitParams& p = t.gaits[g];
     const double row[kColumns] = {p.duty_factor, p.phase_fore_hind, p.phase_left_right, p.swing_time,
                                   p.swing_height, p.swing_peak, p.bob, p.bobs_per_cycle, p.speed_max,
-                                  p.froude_max, p.use_in_auto ? 1.0 : 0.0};
+                                  p.froude_max, p.use_in_auto ? 1.0 : 0.0, p.duty_factor_top};
     std::copy(row, row + kColumns, gaits.mutable_data() + g * kColumns);
   }
   py::dict d;
@@ -97,10 +99,38 @@ void bind_gait(py::module_& m) {
   py::list columns;
   for (const char* c : kGaitColumns) columns.append(c);
   m.attr("GAIT_COLUMNS") = columns;
-  m.attr("GAIT_NAMES") = py::make_tuple("WALK", "TROT", "CANTER", "GALLOP", "GALLOP_ROTARY");
+  py::tuple gait_names(kGaitCount), leg_names(kLegCount);
+  for (int g = 0; g < kGaitCount; ++g) gait_names[g] = kGaitNames[g];
+  for (int leg = 0; leg < kLegCount; ++leg) leg_names[leg] = kLegNames[leg];
+  m.attr("GAIT_NAMES") = gait_names;
+  m.attr("LEG_NAMES") = leg_names;
+  m.attr("GAIT_HORSE_LEG_LENGTH") = kHorseLegLength;
 
-  m.def("gait_horse_table", [] { return table_to(horse_gait_table()); },
-        "The horse defaults: {'gaits': (5, 11) float64 in GAIT_COLUMNS order, 'use_froude', 'hysteresis', 'reach'}.");
+  m.def("gait_horse_table", [](double leg_length) {
+        const GaitTable t = horse_gait_table();
+        return table_to(leg_length > 0 ? scale_table(t, leg_length) : t);
+      }, py::arg("leg_length") = 0.0,
+      "The horse defaults: {'gaits': (5, 12) float64 in GAIT_COLUMNS order, 'use_froude', 'hysteresis', 'reach'};"
+      " with leg_length > 0 (m, hip height), scaled to that animal by dynamic similarity (Froude).");
+
+  m.def("gait_duty_factor", [](const py::dict& table, int gait, double speed, double leg_length) {
+        if (gait < 0 || gait >= kGaitCount) throw py::value_error("gait must be 0..4");
+        return duty_at(table_from(table), static_cast<Gait>(gait), speed, leg_length);
+      }, py::arg("table"), py::arg("gait"), py::arg("speed"), py::arg("leg_length"),
+      "The duty factor a gait uses at a speed (falls with speed where duty_factor_top says so).");
+
+  m.def("gait_check_speeds", [](const py::dict& table, const py::handle& speed, const py::handle& mode,
+                                double leg_length) {
+        const GaitTable t = table_from(table);
+        auto s = checked_array<double>(speed, "speed", -1, 0);
+        const py::ssize_t frames = s.shape(0);
+        auto m = checked_array<double>(mode, "gait_mode", frames, 0);
+        std::vector<int> modes(frames);
+        for (py::ssize_t f = 0; f < frames; ++f) modes[f] = static_cast<int>(m.data()[f]);
+        const SpeedProblem p = check_speeds(t, s.data(), modes.data(), static_cast<int>(frames), leg_length);
+        return py::make_tuple(p.frame, p.top);
+      }, py::arg("table"), py::arg("speed"), py::arg("gait_mode"), py::arg("leg_length"),
+      "(frame index, top speed) of the first frame faster than its gait mode allows, or (-1, 0).");
 
   m.def("gait_validate_table", [](const py::dict& table) { return validate_table(table_from(table)); },
         py::arg("table"), "Empty string when the table is usable, else what is wrong.");
