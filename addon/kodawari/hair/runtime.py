@@ -172,25 +172,8 @@ class ArmatureRuntime:
             pose_bones.foreach_get("matrix", self.matrices.reshape(-1))
             return
         for i in self.matrix_bones:
-            m = pose_bones[i].matrix  # row-major; the solver takes foreach_get's column-major rows
-            self.matrices[i] = (
-                m[0][0],
-                m[1][0],
-                m[2][0],
-                m[3][0],
-                m[0][1],
-                m[1][1],
-                m[2][1],
-                m[3][1],
-                m[0][2],
-                m[1][2],
-                m[2][2],
-                m[3][2],
-                m[0][3],
-                m[1][3],
-                m[2][3],
-                m[3][3],
-            )
+            # Matrix rows are row-major; the solver takes foreach_get's column-major rows.
+            self.matrices[i] = np.array(pose_bones[i].matrix, np.float32).T.reshape(-1)
 
     def _read_other_rotations(self, pose_bones):
         """The current rotations of the bones the solver does not write (foreach_set writes all)."""
