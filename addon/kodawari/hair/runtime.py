@@ -29,6 +29,8 @@ _runtimes = {}
 # must simulate them in order, not jump again).
 _replaying = False
 DEFAULT_CACHE_MEGABYTES = 256
+# Replays of at least this many frames show their progress on the mouse cursor.
+REPLAY_PROGRESS_FRAMES = 24
 
 
 def cache_budget_bytes():
@@ -281,13 +283,23 @@ def _can_replay(depsgraph):
 
 
 def _replay(scene, first, last):
+    """Plays first..last in order; a long replay shows its progress on the cursor."""
+    import bpy
+
     global _replaying
     _replaying = True
+    wm = bpy.context.window_manager if last - first >= REPLAY_PROGRESS_FRAMES else None
+    if wm is not None:
+        wm.progress_begin(first, last)
     try:
         for frame in range(first, last + 1):
             scene.frame_set(frame)  # frame_change_post simulates it (previous frame cached)
+            if wm is not None:
+                wm.progress_update(frame)
     finally:
         _replaying = False
+        if wm is not None:
+            wm.progress_end()
 
 
 def get(obj, build=True):
