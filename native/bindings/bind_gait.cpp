@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <string>
+#include <vector>
 
 #include "arrays.hpp"
 #include "bind.hpp"
@@ -18,10 +19,10 @@ namespace kodawari::bind {
 namespace {
 
 using namespace kodawari::gait;
-constexpr int kColumns = 11;
+constexpr int kColumns = 12;
 const char* kGaitColumns[kColumns] = {"duty_factor", "phase_fore_hind", "phase_left_right", "swing_time",
                                       "swing_height", "swing_peak", "bob", "bobs_per_cycle", "speed_max",
-                                      "froude_max", "use_in_auto"};
+                                      "froude_max", "use_in_auto", "duty_factor_top"};
 
 GaitTable table_from(const py::handle& table) {
   const py::dict d = dict_arg(table, "table");
@@ -41,6 +42,7 @@ GaitTable table_from(const py::handle& table) {
     p.speed_max = r[8];
     p.froude_max = r[9];
     p.use_in_auto = r[10] != 0;
+    p.duty_factor_top = r[11];
   }
   t.use_froude = bool_item(d, "use_froude", "table");
   t.hysteresis = number_item(d, "hysteresis", "table");
@@ -54,7 +56,7 @@ py::dict table_to(const GaitTable& t) {
     const GaitParams& p = t.gaits[g];
     const double row[kColumns] = {p.duty_factor, p.phase_fore_hind, p.phase_left_right, p.swing_time,
                                   p.swing_height, p.swing_peak, p.bob, p.bobs_per_cycle, p.speed_max,
-                                  p.froude_max, p.use_in_auto ? 1.0 : 0.0};
+                                  p.froude_max, p.use_in_auto ? 1.0 : 0.0, p.duty_factor_top};
     std::copy(row, row + kColumns, gaits.mutable_data() + g * kColumns);
   }
   py::dict d;
@@ -97,13 +99,41 @@ void bind_gait(py::module_& m) {
   py::list columns;
   for (const char* c : kGaitColumns) columns.append(c);
   m.attr("GAIT_COLUMNS") = columns;
-  m.attr("GAIT_NAMES") = py::make_tuple("WALK", "TROT", "CANTER", "GALLOP", "GALLOP_ROTARY");
+  py::tuple gait_names(kGaitCount), leg_names(kLegCount);
+  for (int g = 0; g < kGaitCount; ++g) gait_names[g] = kGaitNames[g];
+  for (int leg = 0; leg < kLegCount; ++leg) leg_names[leg] = kLegNames[leg];
+  m.attr("GAIT_NAMES") = gait_names;
+  m.attr("LEG_NAMES") = leg_names;
+  m.attr("GAIT_HORSE_LEG_LENGTH") = kHorseLegLength;
 
-  m.def("gait_horse_table", [] { return table_to(horse_gait_table()); },
-        "The horse defaults: {'gaits': (5, 11) float64 in GAIT_COLUMNS order, 'use_froude', 'hysteresis', 'reach'}.");
+  m.def("gait_horse_table", [](double leg_length) {
+        const GaitTable t = horse_gait_table();
+        return table_to(leg_length > 0 ? scale_table(t, leg_length) : t);
+      }, py::arg("leg_length") = 0.0,
+      "The horse defaults: {'gaits': (5, 12) float64 in GAIT_COLUMNS order, 'use_froude', 'hysteresis', 'reach'};"
+      " with leg_length > 0 (m, hip height), scaled to that animal by dynamic similarity (Froude).");
+
+  m.def("gait_duty_factor", [](const py::dict& table, int gait, double speed, double leg_length) {
+        if (gait < 0 || gait >= kGaitCount) throw py::value_error("gait must be 0..4");
+        return duty_at(table_from(table), static_cast<Gait>(gait), speed, leg_length);
+      }, py::arg("table"), py::arg("gait"), py::arg("speed"), py::arg("leg_length"),
+      "The duty factor a gait uses at a speed (falls with speed where duty_factor_top says so).");
+
+  m.def("gait_check_speeds", [](const py::dict& table, const py::handle& speed, const py::handle& mode,
+                                double leg_length) {
+        const GaitTable t = table_from(table);
+        auto s = checked_array<double>(speed, "speed", -1, 0);
+        const py::ssize_t frames = s.shape(0);
+        auto m = checked_array<double>(mode, "gait_mode", frames, 0);
+        std::vector<int> modes(frames);
+        for (py::ssize_t f = 0; f < frames; ++f) modes[f] = static_cast<int>(m.data()[f]);
+        const SpeedProblem p = check_speeds(t, s.data(), modes.data(), static_cast<int>(frames), leg_length);
+        return py::make_tuple(p.frame, p.top);
+      }, py::arg("table"), py::arg("speed"), py::arg("gait_mode"), py::arg("leg_length"),
+      "(frame index, top speed) of the first frame faster than its gait mode allows, or (-1, 0).");
 
   m.def("gait_validate_table", [](const py::dict& table) { return validate_table(table_from(table)); },
-        "Empty string when the table is usable, else what is wrong.");
+        py::arg("table"), "Empty string when the table is usable, else what is wrong.");
 
   m.def("gait_validate_rig", [](const py::dict& rig) {
         try {
@@ -112,7 +142,7 @@ void bind_gait(py::module_& m) {
           return std::string(e.what());
         }
         return std::string();
-      }, "Empty string when the rig can be solved, else what is wrong.");
+      }, py::arg("rig"), "Empty string when the rig can be solved, else what is wrong.");
 
   m.def("gait_leg_phases", [](const py::dict& table, int gait) {
         if (gait < 0 || gait >= kGaitCount) throw py::value_error("gait must be 0..4");
@@ -120,13 +150,13 @@ void bind_gait(py::module_& m) {
         py::array_t<double> out(kLegCount);
         for (int leg = 0; leg < kLegCount; ++leg) out.mutable_data()[leg] = leg_phase(t.gaits[gait], static_cast<Gait>(gait), leg);
         return out;
-      }, "Lift-off phase of LF, RF, LH, RH relative to LH for one gait.");
+      }, py::arg("table"), py::arg("gait"), "Lift-off phase of LF, RF, LH, RH relative to LH for one gait.");
 
   m.def("gait_seed_swing_distance", [](double speed_new, double speed_old, double swing_time, double duty_factor,
                                        double since_change, double added_time) {
         for (auto [v, n] : {std::pair{speed_new, "speed_new"}, {speed_old, "speed_old"}, {swing_time, "swing_time"},
                             {duty_factor, "duty_factor"}, {since_change, "since_change"}, {added_time, "added_time"}}) {
-          finite_number(v, n);
+          require_finite(v, n);
         }
         if (!(duty_factor < 1)) throw py::value_error("duty_factor must be < 1");
         const double s = seed_swing_distance(speed_new, speed_old, swing_time, duty_factor, since_change, added_time);
@@ -137,13 +167,13 @@ void bind_gait(py::module_& m) {
         "Seed eq. 3.6: S = V'P/(1-a) + (V'-V)C + V't.");
 
   m.def("gait_table_speed_max", [](const py::dict& table, int gait, double leg_length) {
-        return table_speed_max(table_from(table), gait, finite_number(leg_length, "leg_length"));
+        return table_speed_max(table_from(table), gait, require_finite(leg_length, "leg_length"));
       }, py::arg("table"), py::arg("gait"), py::arg("leg_length"),
       "Fastest speed the table covers: AUTO (gait=-1) or one gait.");
 
   m.def("gait_select", [](const py::dict& table, double speed, int current, double leg_length) {
-        return static_cast<int>(select_gait(table_from(table), finite_number(speed, "speed"), current,
-                                            finite_number(leg_length, "leg_length")));
+        return static_cast<int>(select_gait(table_from(table), require_finite(speed, "speed"), current,
+                                            require_finite(leg_length, "leg_length")));
       }, py::arg("table"), py::arg("speed"), py::arg("current"), py::arg("leg_length"));
 
   m.def("gait_ccd_solve", [](const py::dict& chain, const py::handle& target, const py::handle& angles,
@@ -159,7 +189,7 @@ void bind_gait(py::module_& m) {
         auto t = checked_array<double>(target, "target", 2, 0);
         auto a = checked_array<double>(angles, "angles", n, 0);
         if (iterations < 0 || iterations > 100000) throw py::value_error("iterations must be 0..100000");
-        finite_number(tolerance, "tolerance");
+        require_finite(tolerance, "tolerance");
         c.lengths.assign(lengths.data(), lengths.data() + n);
         c.rest_direction.assign(dirs.data(), dirs.data() + n);
         c.limit_min.assign(lo.data(), lo.data() + n);
@@ -195,7 +225,7 @@ void bind_gait(py::module_& m) {
         }
         if (!(fps > 0 && fps <= 1000)) throw py::value_error("fps must be in (0, 1000]");
         if (!(acceleration > 0)) throw py::value_error("acceleration must be > 0");
-        finite_number(acceleration, "acceleration");
+        require_finite(acceleration, "acceleration");
         // The table's speed range (as gait_table_speed_max gives it): past it no gait fits
         // and the legs cannot follow the body (a 10 km/s bake missed its feet by 55 m).
         double leg_length = 0;

@@ -135,7 +135,7 @@ def fish_bake_completes():
 
 # --- gait ----------------------------------------------------------------------
 def gait_scene():
-    from kodawari.gait import samples
+    import gait_samples as samples
 
     scene = fresh_file()
     rig, _ = samples.build_horse(scene)

@@ -18,11 +18,23 @@ def _armature(context):
 
 
 class KODAWARI_OT_gait_setup(bpy.types.Operator):
-    """Find the four legs (by name, or from four selected feet) and the body bone, and fill in horse settings"""
+    """Find the four legs (by name, or from four selected foot bones) and the bone that
+    carries root motion; fill the gait settings with the horse's gait table scaled to
+    this animal and joint ranges from the rig's rest pose"""
 
     bl_idname = "kodawari.gait_setup"
     bl_label = "Gait Setup"
     bl_options = {"REGISTER", "UNDO"}
+
+    limits: bpy.props.EnumProperty(
+        name="Joint Ranges", default="REST",
+        items=(("REST", "From Rest Pose", "Each joint bends the way it bends at rest, within a range around it"),
+               ("HORSE", "Horse", "The seed's horse ranges for 4-bone legs (others from the rest pose)")))
+    root_motion: bpy.props.EnumProperty(
+        name="Root Motion", default="AUTO",
+        items=(("AUTO", "Automatic", "The body bone when the legs share one, else the armature object"),
+               ("BONE", "Body Bone", "The topmost bone carrying the legs whose location Blender applies"),
+               ("OBJECT", "Armature Object", "The armature object itself")))
 
     def execute(self, context):
         obj = _armature(context)
@@ -33,44 +45,65 @@ class KODAWARI_OT_gait_setup(bpy.types.Operator):
         if why:
             self.report({"ERROR"}, why)
             return {"CANCELLED"}
+        try:
+            why = self._setup(context, obj)
+        except ValueError as exc:
+            why = str(exc)
+        if why:
+            self.report({"ERROR"}, why)
+            return {"CANCELLED"}
+        return {"FINISHED"}
+
+    def _setup(self, context, obj):
+        """Everything is checked before anything is written: returns why not, or None."""
         armature = obj.data
         selected = [pb.name for pb in (context.selected_pose_bones or [])] if context.mode == "POSE" else []
         if len(selected) == 4:
+            rigmod.gait_frame(obj)
             legs, how = rigmod.find_legs_from_feet(armature, selected), "from the four selected feet"
         else:
             legs, how = rigmod.find_legs_by_name(armature), "by name"
         missing = [k for k in LEG_NAMES if k not in legs]
         if missing:
             found = ", ".join(f"{k} ({len(v)} bones)" for k, v in legs.items()) or "none"
-            self.report({"ERROR"}, f"Found fewer than four legs {how}: found {found}; missing {', '.join(missing)}. "
-                        "Name leg bones with a side (.L/.R, _L/_R, Left/Right) and an end (fore/front/arm, "
-                        "hind/back/rear), or select the four foot bones in Pose Mode")
-            return {"CANCELLED"}
-        short = [k for k in LEG_NAMES if len(legs[k]) < 2]
-        if short:
-            self.report({"ERROR"}, f"Leg {', '.join(short)} has a single bone; a leg needs 2 to 6 bones")
-            return {"CANCELLED"}
-        body = rigmod.find_body(armature, legs)
-        if body is None:
-            self.report({"ERROR"}, "No body bone: the four legs need a common parent bone to carry root motion")
-            return {"CANCELLED"}
-        # Validate the geometry before touching the settings.
-        probe = {"forward": rigmod.forward_of(armature, legs), "body_head": np.zeros(3), "body_rest": np.eye(3),
-                 "legs": []}
+            return (f"Found fewer than four legs {how}: found {found}; missing {', '.join(missing)}. "
+                    "Name leg bones with a side (.L/.R, _l/_r, Left/Right, 'L ') and a limb (thigh, shin, foot, "
+                    "upper_arm, forearm, hand, or fore/hind), or select the four foot bones in Pose Mode")
         for k in LEG_NAMES:
-            bones = [armature.bones[n] for n in legs[k]]
-            probe["legs"].append({"heads": np.array([b.head_local for b in bones], dtype=np.float64),
-                                  "tail": np.array(bones[-1].tail_local, dtype=np.float64),
-                                  "limit_min": np.full(len(bones), -1.0), "limit_max": np.full(len(bones), 1.0),
-                                  "stiffness": np.ones(len(bones))})
+            if len(legs[k]) < 2:
+                return (f"Leg {k} ('{legs[k][0]}') has a single bone; a leg needs 2 to 6 bones "
+                        "(a bone from the body to the foot cannot bend)")
+            if len(legs[k]) > 6:
+                return f"Leg {k} has {len(legs[k])} bones ({' > '.join(legs[k])}); a leg needs 2 to 6"
+        body = rigmod.find_body(armature, legs)
+        root_motion = self.root_motion
+        if root_motion == "AUTO":
+            root_motion = "BONE" if body is not None else "OBJECT"
+        if root_motion == "BONE" and body is None:
+            return "No body bone: the four legs have no common parent bone to carry root motion " \
+                   "(use Root Motion: Armature Object)"
+        # Validate the geometry before touching the settings.
+        forward = rigmod.forward_of(obj, legs)
+        probe = {"forward": forward, "body_head": np.zeros(3), "body_rest": np.eye(3), "legs": []}
+        ground = min(float(rigmod.leg_points(obj, legs[k])[1][2]) for k in LEG_NAMES)
+        for k in LEG_NAMES:
+            heads, tail = rigmod.leg_points(obj, legs[k])
+            probe["legs"].append({"heads": heads, "tail": tail, "limit_min": np.full(len(heads), -1.0),
+                                  "limit_max": np.full(len(heads), 1.0), "stiffness": np.ones(len(heads))})
+            d = np.diff(np.vstack([heads, tail[None, :]]), axis=0)
+            planar = float(np.hypot(d @ forward, d[:, 2]).sum())
+            drop = float(heads[0][2]) - ground
+            if drop > planar * 0.999:
+                return (f"Leg {k} cannot reach the ground: its root '{legs[k][0]}' is {drop:.3g} m above the "
+                        f"lowest foot but the leg is only {planar:.3g} m long")
         why = native.module().gait_validate_rig(probe)
         if why:
-            self.report({"ERROR"}, f"The legs cannot be solved: {why}")
-            return {"CANCELLED"}
-        rigmod.fill_horse_defaults(obj.kodawari_gait, armature, legs, body)
+            return f"The legs cannot be solved: {why}"
+        rigmod.fill_defaults(obj.kodawari_gait, obj, legs, body, preset=self.limits, root_motion=root_motion)
         summary = "; ".join(f"{k}: {' > '.join(legs[k])}" for k in LEG_NAMES)
-        self.report({"INFO"}, f"Found 4 legs {how} and body bone '{body}'. {summary}")
-        return {"FINISHED"}
+        where = f"body bone '{body}'" if root_motion == "BONE" else "the armature object"
+        self.report({"INFO"}, f"Found 4 legs {how}; root motion on {where}. {summary}")
+        return None
 
 
 class KODAWARI_OT_gait_bake(BakeOperator, bpy.types.Operator):

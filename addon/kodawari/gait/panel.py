@@ -55,6 +55,7 @@ class KODAWARI_PT_gait_rig(_GaitPanel, bpy.types.Panel):
         obj = context.object
         settings = obj.kodawari_gait
         col = layout.column()
+        col.prop(settings, "root_motion")
         col.prop_search(settings, "body_bone", obj.data, "bones")
         col.prop(settings, "ground")
         col.prop(settings, "path")
@@ -104,6 +105,7 @@ def _gait_row_panel(name):
             entry = _entry(settings, name)
             col = layout.column()
             col.prop(entry, "duty_factor", slider=True)
+            col.prop(entry, "duty_factor_top", slider=True)
             col.prop(entry, "phase_fore_hind", slider=True)
             col.prop(entry, "phase_left_right", slider=True)
             col = layout.column()

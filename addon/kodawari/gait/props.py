@@ -10,8 +10,12 @@ GAIT_ITEMS = (
     ("GALLOP", "Gallop", "Transverse gallop: hind feet then fore feet, each pair in the same order"),
     ("GALLOP_ROTARY", "Rotary Gallop", "Rotary gallop: the feet land in a circle (hind left, hind right, fore right, fore left)"),
 )
-GAIT_NAMES = tuple(item[0] for item in GAIT_ITEMS[1:])
-LEG_NAMES = ("LF", "RF", "LH", "RH")
+GAIT_NAMES = tuple(item[0] for item in GAIT_ITEMS[1:])  # the core's kodawari_native.GAIT_NAMES
+LEG_NAMES = ("LF", "RF", "LH", "RH")  # the core's kodawari_native.LEG_NAMES (a test checks both)
+ROOT_MOTION_ITEMS = (
+    ("BONE", "Body Bone", "Key root motion on the body bone (the topmost bone whose location Blender applies)"),
+    ("OBJECT", "Armature Object", "Key root motion on the armature object's delta transforms"),
+)
 
 
 class KodawariGaitBone(bpy.types.PropertyGroup):
@@ -56,6 +60,9 @@ class KodawariGaitEntry(bpy.types.PropertyGroup):
     froude_max: bpy.props.FloatProperty(name="Top Froude", description="Auto by Froude number: the fastest speed, "
                                         "relative to leg length, at which this gait is chosen", default=0.35, min=0.0)
     use_in_auto: bpy.props.BoolProperty(name="In Auto", description="Auto may choose this gait", default=True)
+    duty_factor_top: bpy.props.FloatProperty(name="Duty Factor at Top", description="Share of a stride each foot is "
+                                             "on the ground at the top of the gait's speed band (gallops: the stance "
+                                             "shortens with speed)", subtype="FACTOR", default=0.5, min=0.05, max=0.95)
 
 
 class KodawariGaitSettings(bpy.types.PropertyGroup):
@@ -75,6 +82,8 @@ class KodawariGaitSettings(bpy.types.PropertyGroup):
                                    min=0.05, max=1.0)
     legs: bpy.props.CollectionProperty(type=KodawariGaitLeg, name="Legs", description="The four legs Gait Setup found")
     body_bone: bpy.props.StringProperty(name="Body Bone", description="The bone that carries the animal forward (the legs' common parent)")
+    root_motion: bpy.props.EnumProperty(name="Root Motion", items=ROOT_MOTION_ITEMS, default="BONE",
+                                        description="Where the bake keys the animal's travel")
     ccd_iterations: bpy.props.IntProperty(name="Iterations", default=64, min=1, max=1000,
                                           description="How hard each leg tries to reach its foot target")
     acceleration: bpy.props.FloatProperty(name="Acceleration", description="How quickly the speed may change",
