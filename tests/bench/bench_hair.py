@@ -26,9 +26,9 @@ from mathutils import Vector
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import benchlib
+import wiggle2_port
 
 print = benchlib.say  # each line at once, also through a pipe
-import wiggle2_port  # noqa: E402
 
 BONES, SUBSTEPS = 16, 4
 BONE_LENGTH = 0.02
