@@ -34,7 +34,7 @@ def forget(obj=None):
         _rigs.pop(_key(obj), None)
 
 
-def get_rig(obj, build=True):
+def get_rig(obj, build=True, known_weights=None):
     """The object's bound rig, rebuilt when its binding inputs changed."""
     settings = obj.kodawari_swim
     rig = _rigs.get(_key(obj))
@@ -44,9 +44,21 @@ def get_rig(obj, build=True):
     ):
         rig = None
     if rig is None and build:
-        rig = rig_module.SwimRig(obj, settings)
+        rig = rig_module.SwimRig(obj, settings, known_weights)
         _rigs[_key(obj)] = rig
     return rig
+
+
+def body_rig(obj):
+    """A rig whose rest shape and body axis are current (its fins may be out of date):
+    what checking a new fin needs, without rebinding every fin."""
+    rig = _rigs.get(_key(obj))
+    if rig is not None and (
+        rig.signature[:3] != rig_module.binding_signature(obj, obj.kodawari_swim)[:3]
+        or rig.mesh_pointer != obj.data.as_pointer()
+    ):
+        rig = None
+    return rig if rig is not None else get_rig(obj)
 
 
 @contextlib.contextmanager
@@ -128,8 +140,10 @@ def refresh(obj):
         print(f"Kodawari Swim: {obj.name}: {exc}")
 
 
-def rebind(obj):
+def rebind(obj, known_weights=None):
     forget(obj)
+    if known_weights and _key(obj) not in _batch_depth and is_live(obj):
+        get_rig(obj, known_weights=known_weights)
     refresh(obj)
 
 
