@@ -174,8 +174,11 @@ void bind_swim(py::module_& m) {
         return swim::swim_speed(speed_mode_from(mode), body_length, frequency, amplitude, strouhal);
       },
       py::arg("mode"), py::arg("body_length"), py::arg("frequency"), py::arg("amplitude"), py::arg("strouhal"),
-      "Swimming speed (length units per second): BAINBRIDGE V = L(3f - 4)/4, STROUHAL U = f·A/St with "
-      "A = 2·amplitude·L, NONE 0.");
+      "Swimming speed (length units per second): BAINBRIDGE V = L(3f - 4)/4 held to Strouhal 0.2-0.4, "
+      "STROUHAL U = f·A/St with A = 2·amplitude·L, NONE 0; with amplitude 0 (a fin swimmer) 0.5·L·f.");
+
+  m.def("swim_bainbridge_applies", &swim::bainbridge_applies, py::arg("frequency"),
+        "Whether Bainbridge's V = L(3f - 4)/4 was fitted at this tail-beat frequency (about 5 Hz and up).");
   m.def(
       "swim_fin_axis_coordinates",
       [](const py::handle& axis_points, const py::handle& up, const py::handle& vertices, const py::handle& out,

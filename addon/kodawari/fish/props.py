@@ -183,7 +183,7 @@ class KodawariSwimSettings(bpy.types.PropertyGroup):
     amplitude: FloatProperty(
         name="Amplitude",
         description="Tail-tip peak amplitude as a fraction of body length",
-        default=0.1,
+        default=0.06,
         min=0.0,
         soft_max=0.3,
         max=1.0,
@@ -192,7 +192,7 @@ class KodawariSwimSettings(bpy.types.PropertyGroup):
     amplitude_head: FloatProperty(
         name="Head Amplitude",
         description="Snout peak amplitude as a fraction of body length",
-        default=0.01,
+        default=0.006,
         min=0.0,
         soft_max=0.3,
         max=1.0,
@@ -241,8 +241,22 @@ class KodawariSwimSettings(bpy.types.PropertyGroup):
         name="Speed",
         items=[
             ("NONE", "None", "Swim on the spot"),
-            ("BAINBRIDGE", "Bainbridge", "V = L(3f - 4)/4 (Bainbridge 1958)"),
-            ("STROUHAL", "Strouhal", "U = f A / St, A the tail's peak-to-peak excursion"),
+            (
+                "BAINBRIDGE",
+                "Bainbridge",
+                (
+                    "V = L(3f - 4)/4 (Bainbridge 1958), fitted above about 5 Hz: elsewhere the "
+                    "speed is held to Strouhal 0.2-0.4. Fin swimmers: half a body length per fin beat"
+                ),
+            ),
+            (
+                "STROUHAL",
+                "Strouhal",
+                (
+                    "U = f A / St, A the tail's peak-to-peak excursion. Fin swimmers (no body "
+                    "wave): half a body length per fin beat"
+                ),
+            ),
         ],
         default="NONE",
         update=_speed_changed,
