@@ -94,6 +94,8 @@ class KODAWARI_OT_swim_add(bpy.types.Operator):
             obj.shape_key_add(name="Basis", from_mix=False)
             key = obj.shape_key_add(name=SHAPE_KEY, from_mix=False)
             key.value = 1.0
+            # Edit Mode edits the active key: keep it on the Basis, the rest shape.
+            obj.active_shape_key_index = 0
             settings.enabled = True
         # The handler writes the shape key on frame changes; renders must wait for it.
         context.scene.render.use_lock_interface = True

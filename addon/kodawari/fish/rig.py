@@ -26,6 +26,25 @@ def rest_positions(obj):
     return bulk.vertex_positions(mesh)
 
 
+FINGERPRINT_SAMPLES = 32
+
+
+def rest_fingerprint(obj):
+    """A cheap check (about 40 attribute reads, whatever the vertex count) that the rest
+    shape is the one the rig was bound to: where the rest positions live in memory
+    (leaving Edit Mode rewrites them) and a few of them spread over the mesh (Apply
+    Scale moves them all in place)."""
+    mesh = obj.data
+    keys = mesh.shape_keys
+    data = keys.reference_key.data if keys is not None and keys.reference_key else mesh.vertices
+    n = len(data)
+    if n == 0:
+        return (0,)
+    step = max(1, n // FINGERPRINT_SAMPLES)
+    sample = tuple(tuple(data[i].co) for i in range(0, n, step))
+    return (data[0].as_pointer(), sample)
+
+
 def binding_signature(obj, settings):
     """What the binding depends on; a change means rebuild."""
     fins = tuple(
@@ -41,6 +60,7 @@ class SwimRig:
         kn = native.module()
         self.kn = kn
         self.signature = binding_signature(obj, settings)
+        self.fingerprint = rest_fingerprint(obj)
         self.mesh_pointer = obj.data.as_pointer()
         self.rest = rest_positions(obj)
         self.count = len(self.rest)

@@ -41,6 +41,7 @@ def get_rig(obj, build=True, known_weights=None):
     if rig is not None and (
         rig.signature != rig_module.binding_signature(obj, settings)
         or rig.mesh_pointer != obj.data.as_pointer()
+        or rig.fingerprint != rig_module.rest_fingerprint(obj)  # Apply Scale, Edit-Mode edits
     ):
         rig = None
     if rig is None and build:
@@ -147,8 +148,28 @@ def rebind(obj, known_weights=None):
     refresh(obj)
 
 
+def separate_linked_duplicates(scene):
+    """Linked duplicates (Alt-D) share one mesh and so one swim shape key: each would
+    overwrite the other. Give every live swimmer after the first its own copy of the
+    mesh (what Object > Relations > Make Single User does) so each swims with its own
+    settings, and say so in the console."""
+    owners = {}
+    for obj in sorted(scene.objects, key=lambda o: o.name):
+        if obj.type != "MESH" or not is_live(obj) or obj.data.library is not None:
+            continue
+        owner = owners.setdefault(obj.data.as_pointer(), obj)
+        if owner is not obj:
+            obj.data = obj.data.copy()
+            forget(obj)
+            print(
+                f"Kodawari Swim: '{obj.name}' shared its mesh with '{owner.name}' (a linked "
+                f"duplicate); it now has its own copy so each swims with its own settings"
+            )
+
+
 @persistent
 def on_frame_change(scene, depsgraph=None):
+    separate_linked_duplicates(scene)
     for obj in scene.objects:
         if obj.type != "MESH" or not is_live(obj):
             continue
