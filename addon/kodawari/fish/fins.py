@@ -153,7 +153,10 @@ def build_parts(fin_index, fin, group_weights, verts, body_axis, up, kn, reach_a
             raise ValueError(f"vertex group '{fin.vertex_group}' has no length along the body")
         # The motion fades in over the first root_blend of the fin (SEEDS §1: the root
         # must not move, or the fin tears from the body).
-        blend = _smoothstep(r / max(fin.root_blend, 1e-3))
+        # An undulation's sideways wave fades in over the whole fin height: over a short
+        # root band it would shear the fin's base (its amplitude is a share of the height).
+        span = 1.0 if fin.motion == "UNDULATE" else fin.root_blend
+        blend = _smoothstep(r / max(span, 1e-3))
         weights = group_weights[part_indices] * blend
         rest = np.ascontiguousarray(verts[part_indices], dtype=np.float32)
         parts.append(

@@ -76,7 +76,8 @@ void FinPartBinding::displace(const FinWave& wave, Real phase, const Mat3& body_
       angle = wave.amplitude * std::sin(phase);
       break;
     case FinMotion::Twist:
-      roll = wave.amplitude * std::sin(phase);
+      // A twist of a long-based fin swings its ends; held where the fade would shear past 0.5.
+      roll = std::clamp(wave.amplitude * std::sin(phase), -max_roll_, max_roll_);
       break;
     case FinMotion::Undulate: {
       // Amplitude is a fraction of the fin's height; the wave may not tilt the fin's
@@ -95,11 +96,10 @@ void FinPartBinding::displace(const FinWave& wave, Real phase, const Mat3& body_
       if (wave.motion == FinMotion::Undulate) {
         d = w * undulation * std::sin(phase - k_wave * along_[i]) * f.side;
       } else {
-        // Swing about the vertex's own root point: the lever is its height along the
-        // outward direction (linear in position, so the swing itself never stretches).
+        // Swing about the vertex's own root point: the lever is its reach across the fin.
         const Mat3 swing = angle != 0 ? axis_rotation(hinge_axis, w * angle) : Mat3::Identity();
         const Mat3 twist = roll != 0 ? axis_rotation(outward, w * roll) : Mat3::Identity();
-        d = (swing - Mat3::Identity()) * (height_[i] * outward) + swing * (twist - Mat3::Identity()) * across_[i];
+        d = (swing - Mat3::Identity()) * (reach_[i] * outward) + swing * (twist - Mat3::Identity()) * across_[i];
       }
       d = body_rotation * d;
     }

@@ -1,12 +1,12 @@
 // One fin part bound for motion (docs/algorithms.md, "Fish: fins"). Replaces a
 // per-fin FFD: every fin vertex swings as if hinged at its OWN root point (the
-// lever is its height along the fin's outward direction above the part's root),
+// lever is its reach across the fin, along the fin's outward direction),
 // with the motion's angle faded in by a weight that rises from 0 on the body to 1
 // out on the fin. Neighbouring vertices then get nearly the same rotation, so the
 // fade can shear the mesh only by about 0.9·angle (~1.1x edge stretch at 0.6 rad)
 // and a long-based fin (dorsal, anal) never swings its base ends away from the body.
-// An undulation may not tilt the fin past 45°. max_roll/max_undulation report what
-// the fade could take with a shear under 0.5 (not enforced: feathering needs more).
+// An undulation may not tilt the fin past 45°; a TWIST is held to max_roll (the fade
+// shears under 0.5); feathering is not held (a blade must turn edge-on).
 #pragma once
 
 #include <cstddef>
