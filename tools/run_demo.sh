@@ -15,5 +15,10 @@ for demo in "${demos[@]}"; do
   env $(blender_env) KODAWARI_OUT="$PWD/out" "$BLENDER" "${BLENDER_ARGS[@]}" \
     --python tools/blender_install_addon.py --python "$demo" 2>&1 | grep -vE "^(Fra:|Blender quit|Read blend)" || exit 1
 done
+# Screenshots of the panels need Blender's real window: Xvfb, a tall window so each panel is in view.
+echo "=== demo: blend_samples/ui_screenshots.py"
+env $(blender_env) KODAWARI_OUT="$PWD/out" timeout 600 xvfb-run -a -s "-screen 0 1600x1700x24" "$BLENDER" \
+  --factory-startup -noaudio --window-geometry 0 0 1600 1700 \
+  --python tools/blender_install_addon.py --python blend_samples/ui_screenshots.py 2>&1 | grep -E "wrote|Error|Traceback|File \"" || exit 1
 echo; echo "=== demo wrote:"
 find out -maxdepth 1 -type f -newer "$started" | sort | sed 's/^/  /'

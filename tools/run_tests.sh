@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # Every test tier, then one summary; exits non-zero when any tier fails.
+#   ruff     ruff check and ruff format --check over the Python sources
 #   native   C++ GoogleTest through ctest
 #   python   pytest against kodawari_native, no Blender
+#   fuzz     hypothesis on every kodawari_native entry point (tests/fuzz), crash-safe
 #   blender-3.4  the real program: blender -b ... --python tests/blender/run_pytest.py
 #   ui-3.4       the real program in a window on a virtual screen (modal bakes, Esc)
 #   bpy-4.5, bpy-5.0  the same test files under Blender as a Python module
@@ -25,8 +27,18 @@ tier() {  # name, command...
 
 source tools/blender_env.sh
 
+ruff_tier() {  # lint + format check of the Python sources (rules: pyproject.toml [tool.ruff])
+  local sources=(addon tests tools blend_samples) rc=0
+  "$VENV/bin/ruff" check --output-format junit --exit-zero -o "$REPORTS/ruff.xml" "${sources[@]}"
+  "$VENV/bin/ruff" check "${sources[@]}" || rc=1
+  "$VENV/bin/ruff" format --check "${sources[@]}" || rc=1
+  return $rc
+}
+tier ruff ruff_tier
 tier native ctest --test-dir "$BUILD" --output-on-failure --output-junit "$REPORTS/native.xml"
 tier python env PYTHONPATH="$PWD/addon/kodawari" "$VENV/bin/python" -m pytest -q -p no:cacheprovider tests/python --junitxml="$REPORTS/python.xml"
+# Hypothesis on every kodawari_native entry point (~1 min), in a child process: a crash is reported, not fatal.
+tier fuzz env PYTHONPATH="$PWD/addon/kodawari" "$VENV/bin/python" tests/fuzz/run_fuzz.py --junitxml="$REPORTS/fuzz.xml"
 pip_install_tier() {  # `pip install .` (scikit-build-core, same CMake) into a scratch folder, then the Python tests on it
   local target; target=$(mktemp -d -t kodawari-pip-XXXXXX)
   "$VENV/bin/python" -m pip install -q --no-build-isolation --no-deps --target "$target" \

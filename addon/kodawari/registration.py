@@ -11,13 +11,19 @@ import importlib
 
 import bpy
 
-from . import native, preferences
+from . import menus, native, preferences, problems, sidebar, translations
 
 FEATURE_PACKAGES = ("fish", "hair", "gait")
 
 _registered_classes = []
 _registered_properties = []
 _registered_handlers = []
+_appended_menu_functions = []
+
+
+def registered_classes():
+    """Every class the add-on registered, in order (the menus and tests walk these)."""
+    return tuple(_registered_classes)
 
 
 def _features():
@@ -41,6 +47,7 @@ def register():
     try:
         _register_class(preferences.KodawariPreferences)
         _register_class(preferences.KODAWARI_OT_native_report)
+        _register_class(problems.KODAWARI_OT_report_problem)
         if not native.available():
             # Enable anyway, tools off; say why in the preferences and the report area.
             print(f"Kodawari: {native.error()}")
@@ -56,6 +63,11 @@ def register():
             for list_name, function in feature.HANDLERS:
                 getattr(bpy.app.handlers, list_name).append(function)
                 _registered_handlers.append((list_name, function))
+        # The user interface around the features: menus, sidebar tab, translations.
+        for cls in menus.CLASSES + sidebar.CLASSES:
+            _register_class(cls)
+        _appended_menu_functions.extend(menus.append())
+        translations.register()
     except Exception:
         # Never leave a half-registered add-on behind.
         unregister()
@@ -71,6 +83,10 @@ def _report_native_error():
 
 
 def unregister():
+    translations.unregister()
+    while _appended_menu_functions:
+        menu, function = _appended_menu_functions.pop()
+        menu.remove(function)
     while _registered_handlers:
         list_name, function = _registered_handlers.pop()
         handlers = getattr(bpy.app.handlers, list_name)

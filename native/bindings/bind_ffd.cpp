@@ -1,4 +1,4 @@
-// Python face of the control-axis FFD; the contract is FFD_API.md. Thin: checks
+// Python face of the control-axis FFD; the algorithm is docs/algorithms.md §1. Thin: checks
 // arrays (ValueError naming the argument), converts, releases the GIL.
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
@@ -22,14 +22,6 @@ namespace {
 
 using ffd::AxisBinding;
 
-Vec3List to_points(const py::handle& obj, const char* name) {
-  const auto arr = checked_array<double>(obj, name, -1, 3);
-  const double* data = arr.data();
-  Vec3List points(static_cast<std::size_t>(arr.shape(0)));
-  for (std::size_t i = 0; i < points.size(); ++i) points[i] = Vec3(data[3 * i], data[3 * i + 1], data[3 * i + 2]);
-  return points;
-}
-
 Vec3List to_control_points(const py::handle& obj) {
   Vec3List points = to_points(obj, "control_points");
   ffd::validate_control_points(points, "control_points");
@@ -38,23 +30,12 @@ Vec3List to_control_points(const py::handle& obj) {
 
 std::vector<Real> to_twist(const py::handle& obj, std::size_t count) {
   if (obj.is_none()) return {};
-  const auto arr = checked_array<double>(obj, "twist", static_cast<py::ssize_t>(count), 0);
-  return std::vector<Real>(arr.data(), arr.data() + count);
+  return to_vector(obj, "twist", static_cast<py::ssize_t>(count));
 }
 
 std::optional<Vec3> to_up(const py::handle& obj) {
   if (obj.is_none()) return std::nullopt;
-  const auto arr = checked_array<double>(obj, "up", 3, 0);
-  return Vec3(arr.data()[0], arr.data()[1], arr.data()[2]);
-}
-
-py::array_t<double> points_array(const Vec3List& points) {
-  py::array_t<double> out({static_cast<py::ssize_t>(points.size()), py::ssize_t(3)});
-  double* data = out.mutable_data();
-  for (std::size_t i = 0; i < points.size(); ++i) {
-    for (int k = 0; k < 3; ++k) data[3 * i + k] = points[i][k];
-  }
-  return out;
+  return vec3(obj, "up");
 }
 
 template <typename Field>
@@ -96,9 +77,14 @@ void bind_ffd(py::module_& m) {
             const std::vector<Real> twist_values = to_twist(twist, points.size());
             const std::optional<Vec3> up_hint = to_up(up);
             auto target = checked_output<float>(out, "out", static_cast<py::ssize_t>(b.count()), 3);
+            if (threads > kMaxThreads) throw py::value_error("threads must be 0 (all cores) .. 1024");
             float* data = target.mutable_data();
-            py::gil_scoped_release release;
-            b.deform(points, twist_values, up_hint, data, threads);
+            {
+              py::gil_scoped_release release;
+              b.deform(points, twist_values, up_hint, data, threads);
+            }
+            require_finite_result(data, 3 * b.count(), "control_points: the curve is too close to degenerate to "
+                                                        "deform the mesh (non-finite positions); spread the points apart");
           },
           py::arg("control_points"), py::arg("out"), py::arg("twist") = py::none(), py::arg("up") = py::none(),
           py::arg("threads") = 0,
@@ -114,8 +100,17 @@ void bind_ffd(py::module_& m) {
         if (verts.shape(0) == 0) throw py::value_error("vertices must not be empty");
         const float* data = verts.data();
         const std::size_t count = static_cast<std::size_t>(verts.shape(0));
-        py::gil_scoped_release release;
-        return std::make_shared<AxisBinding>(points, data, count, twist_values, up_hint);
+        std::shared_ptr<AxisBinding> binding;
+        {
+          py::gil_scoped_release release;
+          binding = std::make_shared<AxisBinding>(points, data, count, twist_values, up_hint);
+        }
+        for (const ffd::AxisCoordinate& c : binding->coordinates()) {
+          const float values[4] = {c.fraction, c.u, c.v, c.w};
+          require_finite_result(values, 4, "control_points: the curve is too close to degenerate to bind these "
+                                           "vertices (non-finite coordinates); spread the points apart");
+        }
+        return binding;
       },
       py::arg("control_points"), py::arg("vertices"), py::arg("twist") = py::none(), py::arg("up") = py::none(),
       "Bind float32 (N, 3) vertices to the clamped cubic B-spline of float64 (n, 3) control points (n >= 4).");
@@ -126,7 +121,7 @@ void bind_ffd(py::module_& m) {
         const Vec3List points = to_control_points(control_points);
         const std::vector<Real> twist_values = to_twist(twist, points.size());
         const std::optional<Vec3> up_hint = to_up(up);
-        if (samples < 2) throw py::value_error("samples must be >= 2");
+        if (samples < 2 || samples > 100000) throw py::value_error("samples must be 2..100000");
         const ffd::FrameList frames = ffd::axis_frames(points, twist_values, up_hint, samples);
         py::array_t<double> out({static_cast<py::ssize_t>(samples), py::ssize_t(4), py::ssize_t(3)});
         double* data = out.mutable_data();
@@ -166,8 +161,7 @@ void bind_ffd(py::module_& m) {
       "preserve_lengths",
       [](const py::handle& points, const py::handle& rest_lengths, long moved_index, std::optional<double> arc_length) {
         const Vec3List p = to_points(points, "points");
-        const auto rest = checked_array<double>(rest_lengths, "rest_lengths", -1, 0);
-        const std::vector<Real> lengths(rest.data(), rest.data() + rest.shape(0));
+        const std::vector<Real> lengths = to_vector(rest_lengths, "rest_lengths");
         return points_array(ffd::preserve_lengths(p, lengths, moved_index, arc_length));
       },
       py::arg("points"), py::arg("rest_lengths"), py::arg("moved_index"), py::arg("arc_length") = py::none(),
@@ -178,8 +172,7 @@ void bind_ffd(py::module_& m) {
       "preserve_lengths_from_head",
       [](const py::handle& points, const py::handle& rest_lengths, std::optional<double> arc_length) {
         const Vec3List p = to_points(points, "points");
-        const auto rest = checked_array<double>(rest_lengths, "rest_lengths", -1, 0);
-        const std::vector<Real> lengths(rest.data(), rest.data() + rest.shape(0));
+        const std::vector<Real> lengths = to_vector(rest_lengths, "rest_lengths");
         return points_array(ffd::preserve_lengths_from_head(p, lengths, arc_length));
       },
       py::arg("points"), py::arg("rest_lengths"), py::arg("arc_length") = py::none(),

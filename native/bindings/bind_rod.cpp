@@ -14,31 +14,23 @@
 
 namespace kodawari::bind {
 
-template <>
-inline const char* dtype_name<std::int32_t>() { return "int32"; }
-
 namespace {
 
 using namespace kodawari::rod;
 
-py::array_t<double> to_array(const std::vector<Real>& values) {
-  py::array_t<double> out(static_cast<py::ssize_t>(values.size()));
-  std::copy(values.begin(), values.end(), out.mutable_data());
-  return out;
-}
+// One thread at a time per system: step/reset/store_frame/recall_frame release the GIL.
+ExclusiveUse exclusive(const RodSystem& system) { return ExclusiveUse(&system, "RodSystem"); }
 
-py::array_t<double> to_array(const Vec3List& values) {
-  py::array_t<double> out({static_cast<py::ssize_t>(values.size()), py::ssize_t(3)});
-  double* d = out.mutable_data();
-  for (std::size_t i = 0; i < values.size(); ++i) {
-    for (int c = 0; c < 3; ++c) d[3 * i + c] = values[i][c];
+// Rod bones' rows of a frame's output are finite, else the solve diverged.
+bool rod_rows_finite(const RodSystem& system, const float* rotations) {
+  for (std::size_t r = 0; r < system.rod_count(); ++r) {
+    for (int b : system.rod(r).bones) {
+      for (int c = 0; c < 4; ++c) {
+        if (!std::isfinite(rotations[4 * static_cast<std::size_t>(b) + c])) return false;
+      }
+    }
   }
-  return out;
-}
-
-Vec3 vec3_arg(const py::handle& obj, const char* name) {
-  auto a = checked_array<double>(obj, name, 3, 0);
-  return Vec3(a.data()[0], a.data()[1], a.data()[2]);
+  return true;
 }
 
 // The frame inputs shared by reset() and step(); validates every array.
@@ -57,11 +49,14 @@ FrameInput frame_input(const RodSystem& system, const py::handle& bone_matrices,
   if (std::abs(in.armature_matrix.block<3, 3>(0, 0).determinant()) < 1e-12) {
     throw py::value_error("armature_matrix is singular");
   }
+  for (int r = 0; r < 3; ++r) {
+    if (in.armature_matrix.block<3, 1>(0, r).norm() > 1e6) throw py::value_error("armature_matrix scale is out of range (> 1e6)");
+  }
   in.has_camera = !camera.is_none();
-  if (in.has_camera) in.camera = vec3_arg(camera, "camera");
-  in.gravity = vec3_arg(gravity, "gravity");
-  if (!std::isfinite(time)) throw py::value_error("time must be finite");
-  if (!std::isfinite(frame_dt) || frame_dt < 0) throw py::value_error("frame_dt must be finite and >= 0");
+  if (in.has_camera) in.camera = vec3(camera, "camera");
+  in.gravity = vec3(gravity, "gravity");
+  require_finite(time, "time");
+  if (!std::isfinite(frame_dt) || frame_dt < 0 || frame_dt > 1e3) throw py::value_error("frame_dt must be in [0, 1000] seconds");
   in.time = time;
   in.frame_dt = frame_dt;
   return in;
@@ -76,25 +71,21 @@ std::size_t add_rod(RodSystem& system, int parent_bone, int reference_bone, cons
   auto b = checked_array<std::int32_t>(bones, "bones", -1, 0);
   const py::ssize_t n = b.shape(0);
   if (n == 0) throw py::value_error("bones is empty: a rod needs at least one joint");
-  auto off = checked_array<double>(offsets, "offsets", n + 1, 3);
-  auto rot = checked_array<double>(rest_rotations, "rest_rotations", n, 4);
   auto cond = checked_array<std::int32_t>(key_conditions, "key_conditions", -1, 0);
   const py::ssize_t m = cond.shape(0);
-  auto dirs = checked_array<double>(key_directions, "key_directions", m, 3);
-  auto krot = checked_array<double>(key_rotations, "key_rotations", m, 4);
-  auto speeds = checked_array<double>(key_speeds, "key_speeds", m, 0);
-  auto infl = checked_array<double>(key_influences, "key_influences", m, 0);
-  auto shapes = checked_array<double>(key_shapes, "key_shapes", m * n, 4);
+  const Vec3List dirs = to_points(key_directions, "key_directions", m);
+  const QuatList krot = to_quats(key_rotations, "key_rotations", m);
+  const std::vector<Real> speeds = to_vector(key_speeds, "key_speeds", m);
+  const std::vector<Real> infl = to_vector(key_influences, "key_influences", m);
+  const QuatList shapes = to_quats(key_shapes, "key_shapes", m * n);
   RodDefinition rod;
   rod.parent_bone = parent_bone;
   rod.reference_bone = reference_bone;
   rod.bones.assign(b.data(), b.data() + n);
-  for (py::ssize_t i = 0; i <= n; ++i) {
-    rod.geometry.offsets.emplace_back(off.data()[3 * i], off.data()[3 * i + 1], off.data()[3 * i + 2]);
-  }
-  for (py::ssize_t i = 0; i < n; ++i) {
-    const double* q = rot.data() + 4 * i;
-    rod.geometry.rest_rotations.emplace_back(q[0], q[1], q[2], q[3]);
+  rod.geometry.offsets = to_points(offsets, "offsets", n + 1);
+  rod.geometry.rest_rotations = to_quats(rest_rotations, "rest_rotations", n);
+  for (auto [v, name] : {std::pair{stiffness, "stiffness"}, {damping, "damping"}, {gravity, "gravity"}, {radius, "radius"}}) {
+    require_finite(v, name);
   }
   rod.params.stiffness = stiffness;
   rod.params.damping = damping;
@@ -102,24 +93,25 @@ std::size_t add_rod(RodSystem& system, int parent_bone, int reference_bone, cons
   rod.params.substeps = substeps;
   rod.params.iterations = iterations;
   rod.params.radius = radius;
-  rod.params.wind = vec3_arg(wind, "wind");
+  rod.params.wind = vec3(wind, "wind");
   rod.params.momentum_control = momentum_control;
   for (py::ssize_t i = 0; i < m; ++i) {
     RodKey key;
     const int c = cond.data()[i];
     if (c < 0 || c > 2) throw py::value_error("key_conditions must be 0 (VIEW), 1 (POSE) or 2 (SPEED)");
     key.condition = static_cast<Condition>(c);
-    key.direction = Vec3(dirs.data()[3 * i], dirs.data()[3 * i + 1], dirs.data()[3 * i + 2]);
-    const double* q = krot.data() + 4 * i;
-    key.rotation = Quat(q[0], q[1], q[2], q[3]);
-    key.speed = speeds.data()[i];
-    key.influence = infl.data()[i];
-    for (py::ssize_t k = 0; k < n; ++k) {
-      const double* s = shapes.data() + 4 * (i * n + k);
-      key.shape.emplace_back(s[0], s[1], s[2], s[3]);
-    }
+    const std::string row = "[" + std::to_string(i) + "]";
+    if (c == 0 && !(dirs[i].norm() >= 1e-9)) throw py::value_error("key_directions" + row + ": a view key has a zero or NaN direction");
+    if (c == 1 && !(krot[i].norm() >= 1e-6)) throw py::value_error("key_rotations" + row + ": a pose key has a NaN or zero rotation");
+    if (c == 2 && !(speeds[i] >= 0)) throw py::value_error("key_speeds" + row + ": a speed key needs a speed >= 0");
+    key.direction = dirs[i];
+    key.rotation = krot[i];
+    key.speed = speeds[i];
+    key.influence = infl[i];
+    key.shape.assign(shapes.begin() + i * n, shapes.begin() + (i + 1) * n);
     rod.keys.push_back(std::move(key));
   }
+  const ExclusiveUse use = exclusive(system);
   try {
     return system.add_rod(std::move(rod));
   } catch (const std::invalid_argument& e) {
@@ -133,13 +125,9 @@ void bind_rod(py::module_& m) {
   m.def(
       "view_weights",
       [](const py::handle& key_directions, const py::handle& influences, const py::handle& view) {
-        auto dirs = checked_array<double>(key_directions, "key_directions", -1, 3);
-        const py::ssize_t count = dirs.shape(0);
-        auto infl = checked_array<double>(influences, "influences", count, 0);
-        const Vec3 v = vec3_arg(view, "view");
-        Vec3List d;
-        std::vector<Real> p(infl.data(), infl.data() + count);
-        for (py::ssize_t i = 0; i < count; ++i) d.emplace_back(dirs.data()[3 * i], dirs.data()[3 * i + 1], dirs.data()[3 * i + 2]);
+        const Vec3List d = to_points(key_directions, "key_directions");
+        const std::vector<Real> p = to_vector(influences, "influences", static_cast<py::ssize_t>(d.size()));
+        const Vec3 v = vec3(view, "view");
         try {
           return to_array(view_weights(d, p, v));
         } catch (const std::invalid_argument& e) {
@@ -147,18 +135,17 @@ void bind_rod(py::module_& m) {
         }
       },
       py::arg("key_directions"), py::arg("influences"), py::arg("view"),
-      "Blend weights of view keys (SEEDS.md section 2): w_i = ((dot(d_i, d) + 1) / 2)^p_i, normalised when\n"
+      "Blend weights of view keys (docs/algorithms.md §3.2): w_i = ((dot(d_i, d) + 1) / 2)^p_i, normalised when\n"
       "their sum s >= 1, w_0 = 1 - s. key_directions (m, 3) float64, influences (m,) float64 > 0, view (3,)\n"
       "float64. Returns float64 (m + 1,), w[0] (the base shape) first.");
 
   m.def(
       "condition_weights",
       [](const py::handle& similarities, const py::handle& influences) {
-        auto s = checked_array<double>(similarities, "similarities", -1, 0);
-        auto p = checked_array<double>(influences, "influences", s.shape(0), 0);
+        const std::vector<Real> s = to_vector(similarities, "similarities");
+        const std::vector<Real> p = to_vector(influences, "influences", static_cast<py::ssize_t>(s.size()));
         try {
-          return to_array(condition_weights(std::vector<Real>(s.data(), s.data() + s.shape(0)),
-                                            std::vector<Real>(p.data(), p.data() + p.shape(0))));
+          return to_array(condition_weights(s, p));
         } catch (const std::invalid_argument& e) {
           throw py::value_error(e.what());
         }
@@ -170,7 +157,10 @@ void bind_rod(py::module_& m) {
                         "Every rod of one armature. Frame inputs and outputs are flat arrays for all bones:\n"
                         "bone_matrices (B, 16) float32 as pose.bones.foreach_get('matrix') gives them,\n"
                         "rotations_out (B, 4) float32 (w, x, y, z) as foreach_get('rotation_quaternion').")
-      .def(py::init<std::size_t, unsigned>(), py::arg("bone_count"), py::arg("threads") = 0)
+      .def(py::init([](std::size_t bone_count, unsigned threads) {
+             if (threads > kMaxThreads) throw py::value_error("threads must be 0 (all cores) .. 1024");
+             return std::make_unique<RodSystem>(bone_count, threads);
+           }), py::arg("bone_count"), py::arg("threads") = 0)
       .def_property_readonly("rod_count", &RodSystem::rod_count)
       .def_property_readonly("bone_count", &RodSystem::bone_count)
       .def("add_rod", &add_rod, py::arg("parent_bone"), py::arg("reference_bone"), py::arg("bones"),
@@ -190,7 +180,7 @@ void bind_rod(py::module_& m) {
             auto b = checked_array<std::int32_t>(bones, "bones", -1, 0);
             const py::ssize_t c = b.shape(0);
             auto cap = checked_array<std::int32_t>(capsule, "capsule", c, 0);
-            auto off = checked_array<double>(offsets, "offsets", c, 3);
+            const Vec3List off = to_points(offsets, "offsets", c);
             auto rad = checked_array<double>(radii, "radii", c, 0);
             auto len = checked_array<double>(lengths, "lengths", c, 0);
             std::vector<ColliderDefinition> list;
@@ -198,11 +188,12 @@ void bind_rod(py::module_& m) {
               ColliderDefinition d;
               d.bone = b.data()[i];
               d.capsule = cap.data()[i] != 0;
-              d.offset = Vec3(off.data()[3 * i], off.data()[3 * i + 1], off.data()[3 * i + 2]);
+              d.offset = off[i];
               d.radius = rad.data()[i];
               d.length = len.data()[i];
               list.push_back(d);
             }
+            const ExclusiveUse use = exclusive(self);
             try {
               self.set_colliders(std::move(list));
             } catch (const std::invalid_argument& e) {
@@ -218,6 +209,8 @@ void bind_rod(py::module_& m) {
             py::array_t<float> keep;
             const FrameInput in = frame_input(self, bone_matrices, armature_matrix, camera, gravity, time, 0.0, keep);
             auto out = checked_output<float>(rotations_out, "rotations_out", static_cast<py::ssize_t>(self.bone_count()), 4);
+            no_overlap(out, "rotations_out", keep, "bone_matrices");
+            const ExclusiveUse use = exclusive(self);
             float* out_data = out.mutable_data();
             py::gil_scoped_release release;
             self.reset(in, out_data);
@@ -234,43 +227,57 @@ void bind_rod(py::module_& m) {
             const FrameInput in =
                 frame_input(self, bone_matrices, armature_matrix, camera, gravity, time, frame_dt, keep);
             auto out = checked_output<float>(rotations_out, "rotations_out", static_cast<py::ssize_t>(self.bone_count()), 4);
+            no_overlap(out, "rotations_out", keep, "bone_matrices");
+            const ExclusiveUse use = exclusive(self);
             float* out_data = out.mutable_data();
-            py::gil_scoped_release release;
-            self.step(in, out_data);
+            bool finite = true;
+            {
+              py::gil_scoped_release release;
+              self.step(in, out_data);
+              finite = rod_rows_finite(self, out_data);
+              if (!finite) self.reset(in, out_data);  // leave the system usable, at rest
+            }
+            if (!finite) {
+              throw py::value_error("the rods diverged (check gravity, wind, armature_matrix and frame_dt); "
+                                    "they were reset to rest");
+            }
           },
           py::arg("bone_matrices"), py::arg("armature_matrix"), py::arg("camera"), py::arg("gravity"),
           py::arg("time"), py::arg("frame_dt"), py::arg("rotations_out"),
           "Advances every rod by frame_dt seconds (camera: world position (3,) float64, or None).")
       .def("joint_positions", [](const RodSystem& self, std::size_t rod) {
+             const ExclusiveUse use = exclusive(self);
              if (rod >= self.rod_count()) throw py::index_error("rod index out of range");
-             return to_array(self.joint_positions(rod));
+             return points_array(self.joint_positions(rod));
            }, py::arg("rod"), "Joint positions (heads and tip, (n + 1, 3)) in armature space.")
       .def("joint_velocities", [](const RodSystem& self, std::size_t rod) {
+             const ExclusiveUse use = exclusive(self);
              if (rod >= self.rod_count()) throw py::index_error("rod index out of range");
-             return to_array(self.joint_velocities(rod));
+             return points_array(self.joint_velocities(rod));
            }, py::arg("rod"))
       .def("weights", [](const RodSystem& self, std::size_t rod) {
+             const ExclusiveUse use = exclusive(self);
              if (rod >= self.rod_count()) throw py::index_error("rod index out of range");
              return to_array(self.weights(rod));
            }, py::arg("rod"), "This frame's weights (m + 1,), base shape first.")
       .def("reference_speed", [](const RodSystem& self, std::size_t rod) {
+             const ExclusiveUse use = exclusive(self);
              if (rod >= self.rod_count()) throw py::index_error("rod index out of range");
              return self.reference_speed(rod);
            }, py::arg("rod"))
       .def("rest_shape", [](const RodSystem& self, std::size_t rod) {
+             const ExclusiveUse use = exclusive(self);
              if (rod >= self.rod_count()) throw py::index_error("rod index out of range");
-             const QuatList& q = self.rest_shape(rod);
-             py::array_t<double> out({static_cast<py::ssize_t>(q.size()), py::ssize_t(4)});
-             double* d = out.mutable_data();
-             for (std::size_t i = 0; i < q.size(); ++i) {
-               d[4 * i] = q[i].w(); d[4 * i + 1] = q[i].x(); d[4 * i + 2] = q[i].y(); d[4 * i + 3] = q[i].z();
-             }
-             return out;
+             return quats_array(self.rest_shape(rod));
            }, py::arg("rod"), "The rest shape blended this frame, (n, 4) rotations.")
-      .def("save_state", [](const RodSystem& self) { return to_array(self.save_state()); },
+      .def("save_state", [](const RodSystem& self) {
+             const ExclusiveUse use = exclusive(self);
+             return to_array(self.save_state());
+           },
            "The full simulation state (float64), for exact per-frame caches.")
       .def("load_state", [](RodSystem& self, const py::handle& state) {
-             auto s = checked_array<double>(state, "state", -1, 0, false);
+             auto s = checked_array<double>(state, "state", -1, 0);
+             const ExclusiveUse use = exclusive(self);
              try {
                self.load_state(std::vector<Real>(s.data(), s.data() + s.shape(0)));
              } catch (const std::invalid_argument& e) {
@@ -280,6 +287,7 @@ void bind_rod(py::module_& m) {
       // The exact per-frame cache (scrubbing), kept natively: see rod/frame_cache.hpp.
       .def("store_frame", [](RodSystem& self, int frame, const py::handle& rotations) {
              auto r = checked_array<float>(rotations, "rotations", static_cast<py::ssize_t>(self.bone_count()), 4);
+             const ExclusiveUse use = exclusive(self);
              const float* data = r.data();
              py::gil_scoped_release release;
              self.store_frame(frame, data);
@@ -292,25 +300,57 @@ void bind_rod(py::module_& m) {
                out = checked_output<float>(rotations_out, "rotations_out", static_cast<py::ssize_t>(self.bone_count()), 4);
                out_data = out.mutable_data();
              }
+             const ExclusiveUse use = exclusive(self);
              py::gil_scoped_release release;
              return self.recall_frame(frame, out_data, load_state);
            }, py::arg("frame"), py::arg("rotations_out") = py::none(), py::arg("load_state") = true,
            "Loads a cached frame's state (if load_state) and writes its rod-bone rows into rotations_out;\n"
            "False when the frame is not cached.")
-      .def("cached_frames", [](const RodSystem& self) { return self.frame_cache().frames(); },
+      .def("cached_frames", [](RodSystem& self) {
+             const ExclusiveUse use = exclusive(self);
+             return self.frame_cache().frames();
+           },
            "The cached frames, ascending.")
-      .def("latest_cached_frame_before", [](const RodSystem& self, int frame) {
+      .def("latest_cached_frame_before", [](RodSystem& self, int frame) {
+             const ExclusiveUse use = exclusive(self);
              return self.frame_cache().latest_before(frame);
            }, py::arg("frame"), "The latest cached frame before `frame`, or None.")
-      .def("clear_cache", [](RodSystem& self) { self.frame_cache().clear(); })
-      .def("cached_state", [](const RodSystem& self, int frame) -> py::object {
+      .def("clear_cache", [](RodSystem& self) {
+             const ExclusiveUse use = exclusive(self);
+             self.frame_cache().clear();
+           })
+      .def_property(
+          "cache_budget", [](RodSystem& self) {
+            const ExclusiveUse use = exclusive(self);
+            return self.frame_cache().budget();
+          },
+          [](RodSystem& self, std::size_t bytes) {
+            const ExclusiveUse use = exclusive(self);
+            self.frame_cache().set_budget(bytes);
+          },
+          "Bytes the frame cache may hold (0: unbounded). Over it, frames thin out to checkpoints\n"
+          "(see rod/frame_cache.hpp): recall_frame() is then False for a dropped frame, which is\n"
+          "recomputed exactly from latest_cached_frame_before() by stepping on.")
+      .def_property_readonly("cache_bytes", [](RodSystem& self) {
+                               const ExclusiveUse use = exclusive(self);
+                               return self.frame_cache().bytes();
+                             },
+                             "Bytes the frame cache holds now.")
+      .def_property_readonly("cache_checkpoint_interval", [](RodSystem& self) {
+                               const ExclusiveUse use = exclusive(self);
+                               return self.frame_cache().checkpoint_interval();
+                             },
+                             "Frames between the checkpoints kept once the budget thinned the cache.")
+      .def("cached_state", [](RodSystem& self, int frame) -> py::object {
+             const ExclusiveUse use = exclusive(self);
              const FrameCache::Entry* e = self.frame_cache().find(frame);
              if (e == nullptr) return py::none();
              py::array_t<double> out(static_cast<py::ssize_t>(e->state_size));
              std::copy_n(e->state.get(), e->state_size, out.mutable_data());
              return out;
            }, py::arg("frame"), "A cached frame's full state (as save_state gives it), or None.")
-      .def("cached_rotations", [](const RodSystem& self, int frame) -> py::object {
+      .def("cached_rotations", [](RodSystem& self, int frame) -> py::object {
+             const ExclusiveUse use = exclusive(self);
              const FrameCache::Entry* e = self.frame_cache().find(frame);
              if (e == nullptr) return py::none();
              py::array_t<float> out({static_cast<py::ssize_t>(e->rotations.size() / 4), py::ssize_t(4)});

@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <memory>
+#include <stdexcept>
 #include <string>
 
 #include "arrays.hpp"
@@ -20,31 +21,13 @@ namespace kodawari::bind {
 
 namespace {
 
-Vec3List to_points(const py::array_t<double>& a) {
-  Vec3List points(static_cast<std::size_t>(a.shape(0)));
-  const double* d = a.data();
-  for (std::size_t i = 0; i < points.size(); ++i) points[i] = Vec3(d[3 * i], d[3 * i + 1], d[3 * i + 2]);
-  return points;
-}
-
-py::array_t<double> from_points(const Vec3List& points) {
-  py::array_t<double> out({static_cast<py::ssize_t>(points.size()), py::ssize_t(3)});
-  double* d = out.mutable_data();
-  for (std::size_t i = 0; i < points.size(); ++i) {
-    for (int c = 0; c < 3; ++c) d[3 * i + c] = points[i][c];
+// A swim result from finite arguments is finite, else the arguments are out of the
+// kernel's range (e.g. a negative envelope_power at the head).
+py::array_t<double> finite_points(const Vec3List& points, const char* arguments) {
+  for (const Vec3& p : points) {
+    if (!p.allFinite()) throw py::value_error(std::string(arguments) + " give a non-finite result: bring them into range");
   }
-  return out;
-}
-
-Vec3 unit_vector(const py::handle& obj, const char* name) {
-  auto a = checked_array<double>(obj, name, 3, 0);
-  Vec3 v(a.data()[0], a.data()[1], a.data()[2]);
-  if (v.norm() < 1e-12) throw py::value_error(std::string(name) + " must not be the zero vector");
-  return v.normalized();
-}
-
-void require_finite(double value, const char* name) {
-  if (!std::isfinite(value)) throw py::value_error(std::string(name) + " must be finite");
+  return points_array(points);
 }
 
 swim::FinMotion fin_motion_from(const std::string& name) {
@@ -93,7 +76,13 @@ void bind_swim(py::module_& m) {
         if (wavelength <= 0) throw py::value_error("wavelength must be positive");
         swim::BodyWave wave{wavelength, amplitude, amplitude_head, envelope_start, envelope_power, phase_offset,
                             preserve_length};
-        return from_points(swim::body_axis(to_points(rest), bend, body_length, wave, phase));
+        Vec3List axis;
+        try {
+          axis = swim::body_axis(to_points(rest, "rest_points"), bend, body_length, wave, phase);
+        } catch (const std::invalid_argument& e) {  // the core names its own terms: say which argument
+          throw py::value_error(std::string("rest_points: ") + e.what());
+        }
+        return finite_points(axis, "amplitude, amplitude_head, envelope_start and envelope_power");
       },
       py::arg("rest_points"), py::arg("bend_direction"), py::arg("body_length"), py::arg("phase"),
       py::arg("wavelength") = 1.0, py::arg("amplitude") = 0.1, py::arg("amplitude_head") = 0.0,
@@ -105,12 +94,18 @@ void bind_swim(py::module_& m) {
   m.def(
       "swim_wave_envelope",
       [](double s, double amplitude, double amplitude_head, double envelope_start, double envelope_power) {
+        for (auto [v, n] : {std::pair{s, "s"}, {amplitude, "amplitude"}, {amplitude_head, "amplitude_head"},
+                            {envelope_start, "envelope_start"}, {envelope_power, "envelope_power"}}) {
+          require_finite(v, n);
+        }
         swim::BodyWave wave;
         wave.amplitude = amplitude;
         wave.amplitude_head = amplitude_head;
         wave.envelope_start = envelope_start;
         wave.envelope_power = envelope_power;
-        return swim::wave_envelope(wave, s);
+        const double peak = swim::wave_envelope(wave, s);
+        if (!std::isfinite(peak)) throw py::value_error("envelope_power and s give a non-finite envelope");
+        return peak;
       },
       py::arg("s"), py::arg("amplitude"), py::arg("amplitude_head"), py::arg("envelope_start"),
       py::arg("envelope_power"), "Peak amplitude (fraction of body length) at body fraction s.");
@@ -130,10 +125,14 @@ void bind_swim(py::module_& m) {
         if (wavelength <= 0) throw py::value_error("wavelength must be positive");
         swim::FinWave wave{fin_motion_from(motion), amplitude, feathering, feather_on_power, wavelength,
                            fixed_count};
-        const swim::FinPose pose = swim::fin_axis(to_points(rest), frame, wave, phase);
-        py::array_t<double> twist(static_cast<py::ssize_t>(pose.twist.size()));
-        std::copy(pose.twist.begin(), pose.twist.end(), twist.mutable_data());
-        return py::make_tuple(from_points(pose.points), twist);
+        swim::FinPose pose;
+        try {
+          pose = swim::fin_axis(to_points(rest, "rest_points"), frame, wave, phase);
+        } catch (const std::invalid_argument& e) {
+          throw py::value_error(std::string("rest_points: ") + e.what());
+        }
+        require_finite_result(pose.twist.data(), pose.twist.size(), "amplitude and feathering give a non-finite twist");
+        return py::make_tuple(finite_points(pose.points, "amplitude, feathering and fixed_count"), to_array(pose.twist));
       },
       py::arg("rest_points"), py::arg("tangent"), py::arg("side"), py::arg("up"), py::arg("motion"),
       py::arg("amplitude"), py::arg("phase"), py::arg("feathering") = 0.0, py::arg("wavelength") = 1.0,
@@ -145,10 +144,7 @@ void bind_swim(py::module_& m) {
       "swim_flap_stroke_direction",
       [](const py::handle& fin_axis, const py::handle& tangent, const py::handle& side, const py::handle& up) {
         swim::RootFrame frame{unit_vector(tangent, "tangent"), unit_vector(side, "side"), unit_vector(up, "up")};
-        const Vec3 d = swim::flap_stroke_direction(unit_vector(fin_axis, "fin_axis"), frame);
-        py::array_t<double> out(3);
-        for (int c = 0; c < 3; ++c) out.mutable_data()[c] = d[c];
-        return out;
+        return vec3_array(swim::flap_stroke_direction(unit_vector(fin_axis, "fin_axis"), frame));
       },
       py::arg("fin_axis"), py::arg("tangent"), py::arg("side"), py::arg("up"),
       "Unit direction a FLAP power stroke moves the fin tip in.");
@@ -156,14 +152,11 @@ void bind_swim(py::module_& m) {
   m.def(
       "swim_accumulate_phase",
       [](const py::handle& frequencies, double dt, double phase0) {
-        auto f = checked_array<double>(frequencies, "frequencies", -1, 0);
+        const std::vector<double> values = to_vector(frequencies, "frequencies");
         require_finite(dt, "dt");
         require_finite(phase0, "phase0");
-        std::vector<double> values(f.data(), f.data() + f.size());
         const std::vector<double> phase = swim::accumulate_phase(values, dt, phase0);
-        py::array_t<double> out(static_cast<py::ssize_t>(phase.size()));
-        std::copy(phase.begin(), phase.end(), out.mutable_data());
-        return out;
+        return to_array(phase);
       },
       py::arg("frequencies"), py::arg("dt"), py::arg("phase0") = 0.0,
       "Phases (radians) of a sampled frequency (Hz), accumulated by the trapezoid rule (φ += ω·dt).");
@@ -171,7 +164,13 @@ void bind_swim(py::module_& m) {
   m.def(
       "swim_speed",
       [](const std::string& mode, double body_length, double frequency, double amplitude, double strouhal) {
-        return swim::swim_speed(speed_mode_from(mode), body_length, frequency, amplitude, strouhal);
+        for (auto [v, n] : {std::pair{body_length, "body_length"}, {frequency, "frequency"}, {amplitude, "amplitude"},
+                            {strouhal, "strouhal"}}) {
+          require_finite(v, n);
+        }
+        const double speed = swim::swim_speed(speed_mode_from(mode), body_length, frequency, amplitude, strouhal);
+        if (!std::isfinite(speed)) throw py::value_error("strouhal must not be 0 (the speed is not finite)");
+        return speed;
       },
       py::arg("mode"), py::arg("body_length"), py::arg("frequency"), py::arg("amplitude"), py::arg("strouhal"),
       "Swimming speed (length units per second): BAINBRIDGE V = L(3f - 4)/4 held to Strouhal 0.2-0.4, "

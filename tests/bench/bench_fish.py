@@ -1,16 +1,28 @@
-"""Fish swim benchmark (run in Blender 3.4 by tools/run_bench.sh; prints figures, never fails on time).
+"""Fish swim, whole frame against whole frame (run by tools/run_bench.sh in every Blender;
+prints figures, never fails on time; writes out/bench.json -> fish).
 
-1. A 1 M-vertex fish per frame: our live evaluation against Blender's Curve
-   modifier bending the same mesh along a curve whose points move every frame
-   (the built-in way to make a fish swim), in this one process.
-2. A 100 k-vertex fish (with fins): milliseconds per frame.
+For a smooth fish-shaped quad body of 100 k, 1 M and 4 M vertices, each side gets the same
+per-frame treatment a viewport gives it: `scene.frame_set(f)`, then the depsgraph evaluates
+whatever is tagged, then the evaluated mesh's vertex normals are read (a viewport draws them).
 
-"ours (kernel + write)" = body and fin axes, native FFD deform into a preallocated
-array and one write into the shape key; "ours (frame)" = a whole scene.frame_set,
-i.e. that plus Blender re-evaluating the mesh (copy-on-write, shape key mix), which
-the Curve modifier pays too ("Blender's own mesh update" measures that floor).
+  kodawari        the add-on's live swim (frame handler -> native FFD -> shape key write)
+  geometry_nodes  a Geometry Nodes bend of the same mesh along the same animated curve:
+                  Sample Curve (factor = position along the body) -> Set Position
+                  (curve point + normal * y + binormal * z), built here through the node API
+  curve_modifier  Blender's Curve modifier on the same mesh along the same curve
+  floor           the same mesh with Basis + one shape key whose value is animated: the least
+                  Blender does for a mesh that changes every frame
+
+"The same animated curve": a NURBS curve of order 4 with endpoint knots (the clamped cubic
+B-spline our FFD uses) whose control points are keyframed, for every frame played, to the
+control axis the fish computes at that frame.
+
+Each side lives in its own Scene, so a frame_set evaluates that side only; sides are timed
+interleaved round by round in one process (ratios like for like), and each side's peak memory
+comes from its own child process (see benchlib).
 """
 
+import gc
 import os
 import sys
 import time
@@ -18,135 +30,404 @@ import time
 import bpy
 import numpy as np
 
-ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-sys.path.insert(0, os.path.join(ROOT, "blend_samples"))
-import fish_shapes
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import benchlib
 
-FRAMES = 8
+print = benchlib.say  # each line at once, also through a pipe
+
+# (vertices around, rings along, frames per round)
+SIZES = {100_000: (250, 400, 8), 1_000_000: (1000, 1000, 4), 4_000_000: (2000, 2000, 2)}
+SIDES = ("kodawari", "geometry_nodes", "curve_modifier", "floor")
+LENGTH = 1.0
 
 
-def _fish(rings, segments, fins=True):
-    obj = fish_shapes.build_fish("tuna", rings=rings, segments=segments, fin_rows=8 if fins else 2)
-    if not fins:
-        for group in list(obj.vertex_groups):
-            obj.vertex_groups.remove(group)
+# ----------------------------------------------------------------------------- the mesh
+
+
+def fish_body_mesh(name, ring, rings):
+    """A closed-profile smooth quad body along +X (head at +X), fish-like taper, ring*rings vertices."""
+    s = np.linspace(0.0, 1.0, rings)  # 0 tail .. 1 snout
+    x = (s - 0.5) * LENGTH
+    half_w = 0.08 * np.sin(np.pi * np.clip(s, 0.02, 0.98)) ** 0.6 + 0.004
+    half_h = 1.35 * half_w
+    angle = np.linspace(0, 2 * np.pi, ring, endpoint=False)
+    co = np.empty((rings, ring, 3), np.float32)
+    co[..., 0] = x[:, None]
+    co[..., 1] = half_w[:, None] * np.cos(angle)[None, :]
+    co[..., 2] = half_h[:, None] * np.sin(angle)[None, :]
+    k = np.arange(ring)
+    base = (np.arange(rings - 1) * ring)[:, None]
+    quads = np.stack(
+        [base + k, base + ring + k, base + ring + (k + 1) % ring, base + (k + 1) % ring], -1
+    )
+    quads = quads.reshape(-1, 4).astype(np.int32)
+    mesh = bpy.data.meshes.new(name)
+    mesh.vertices.add(ring * rings)
+    mesh.vertices.foreach_set("co", co.reshape(-1))
+    mesh.loops.add(quads.size)
+    mesh.loops.foreach_set("vertex_index", quads.reshape(-1))
+    mesh.polygons.add(len(quads))
+    mesh.polygons.foreach_set("loop_start", np.arange(0, quads.size, 4, dtype=np.int32))
+    if bpy.app.version < (4, 0, 0):
+        mesh.polygons.foreach_set("loop_total", np.full(len(quads), 4, np.int32))
+    mesh.polygons.foreach_set("use_smooth", np.ones(len(quads), bool))
+    mesh.update(calc_edges=True)
+    return mesh
+
+
+# ----------------------------------------------------------------------------- the sides
+
+
+def new_scene(name):
+    scene = bpy.data.scenes.new(name)
+    scene.render.fps = 24
+    scene.frame_start, scene.frame_end = 1, 250
+    return scene
+
+
+def add_object(scene, name, data):
+    obj = bpy.data.objects.new(name, data)
+    scene.collection.objects.link(obj)
+    return obj
+
+
+def make_kodawari(scene, mesh):
+    """Only in bpy.context.scene: the operator works on the active object."""
+    obj = add_object(scene, "fish_kodawari", mesh)
     bpy.context.view_layer.objects.active = obj
     obj.select_set(True)
-    bpy.ops.kodawari.swim_add(head_axis="POS_X", preset="CARANGIFORM", frequency=2.0)
-    for group in obj.vertex_groups:
-        bpy.ops.kodawari.swim_fin_add(
-            vertex_group=group.name, kind=group.name.split("_")[1].upper()
-        )
+    result = bpy.ops.kodawari.swim_add(head_axis="POS_X", preset="CARANGIFORM", frequency=2.0)
+    assert result == {"FINISHED"}, result
     obj.select_set(False)
     return obj
 
 
-def _time_ours(obj):
+def fish_axes(obj, scene, frames):
+    """The fish's control axis (K, 3) at each frame, object space; and its rest axis."""
     from kodawari.fish import runtime
 
-    scene = bpy.context.scene
-    runtime.evaluate(obj, scene, 1)  # warm
-    kernel = []
-    for frame in range(2, 2 + FRAMES):
-        t = time.perf_counter()
+    rig = runtime.get_rig(obj)
+    axes = {}
+    for frame in frames:
         runtime.evaluate(obj, scene, frame)
-        kernel.append(time.perf_counter() - t)
-    full = []
-    for frame in range(2, 2 + FRAMES):
-        t = time.perf_counter()
-        scene.frame_set(frame)
-        bpy.context.evaluated_depsgraph_get()
-        full.append(time.perf_counter() - t)
-    return float(np.median(kernel)), float(np.median(full))
+        axes[frame] = np.array(rig.axis, dtype=np.float64).tolist()
+    return axes, np.array(rig.axis_rest, dtype=np.float64).tolist()
 
 
-def _time_blender_floor(obj):
-    """Blender re-evaluating the same mesh after a tag, with no deformer work at all:
-    the floor any per-frame deformer (ours or the Curve modifier) pays on top."""
-    obj.kodawari_swim.enabled = False
-    depsgraph = bpy.context.evaluated_depsgraph_get()
-    times = []
-    for _ in range(FRAMES):
-        obj.data.update_tag()
-        t = time.perf_counter()
-        depsgraph.update()
-        times.append(time.perf_counter() - t)
-    obj.kodawari_swim.enabled = True
-    return float(np.median(times))
+def animated_axis_curve(scene, axes):
+    """A NURBS curve (order 4, endpoint knots) whose control points follow `axes` frame by frame."""
+    frames = sorted(axes)
+    count = len(axes[frames[0]])
+    data = bpy.data.curves.new("axis", "CURVE")
+    data.dimensions = "3D"
+    spline = data.splines.new("NURBS")
+    spline.points.add(count - 1)
+    spline.order_u = 4
+    spline.use_endpoint_u = True
+    for frame in frames:
+        for point, co in zip(spline.points, axes[frame]):
+            point.co = (co[0], co[1], co[2], 1.0)
+            point.keyframe_insert("co", frame=frame)
+    return add_object(scene, "axis", data)
 
 
-def _time_curve_modifier(obj):
-    """A copy of the mesh bent by Blender's Curve modifier along a 16-point curve
-    whose points move each frame (what a user would animate without Kodawari)."""
-    mesh = obj.data.copy()
-    copy = bpy.data.objects.new("curve_fish", mesh)
-    bpy.context.scene.collection.objects.link(copy)
-    if copy.data.shape_keys is not None:
-        copy.shape_key_clear()
-    curve_data = bpy.data.curves.new("spine", "CURVE")
-    curve_data.dimensions = "3D"
-    spline = curve_data.splines.new("POLY")
-    spline.points.add(15)
-    xs = np.linspace(-0.6, 0.6, 16)
-    curve = bpy.data.objects.new("spine", curve_data)
-    bpy.context.scene.collection.objects.link(curve)
-    modifier = copy.modifiers.new("Curve", "CURVE")
+def _new_socket(group, name, in_out, socket_type):
+    if hasattr(group, "interface"):  # 4.0+
+        group.interface.new_socket(name=name, in_out=in_out, socket_type=socket_type)
+    else:  # 3.x
+        (group.inputs if in_out == "INPUT" else group.outputs).new(socket_type, name)
+
+
+def gn_bend_group(curve, rest_axis):
+    """Geometry Nodes: position = P(t) + N(t) * (y - y0) + (T x N)(t) * (z - z0), t = (x - x_tail) / length,
+    P, T, N from Sample Curve (factor mode) on the axis curve."""
+    rest = np.asarray(rest_axis)
+    lo, hi = float(rest[:, 0].min()), float(rest[:, 0].max())
+    y0, z0 = float(rest[:, 1].mean()), float(rest[:, 2].mean())
+    group = bpy.data.node_groups.new("bench_bend", "GeometryNodeTree")
+    _new_socket(group, "Geometry", "INPUT", "NodeSocketGeometry")
+    _new_socket(group, "Geometry", "OUTPUT", "NodeSocketGeometry")
+    nodes, links = group.nodes, group.links
+    group_in, group_out = nodes.new("NodeGroupInput"), nodes.new("NodeGroupOutput")
+    info = nodes.new("GeometryNodeObjectInfo")
+    info.inputs["Object"].default_value = curve
+    info.transform_space = "RELATIVE"
+    position = nodes.new("GeometryNodeInputPosition")
+    split = nodes.new("ShaderNodeSeparateXYZ")
+    links.new(position.outputs[0], split.inputs[0])
+    factor = nodes.new("ShaderNodeMath")
+    factor.operation = "MULTIPLY_ADD"
+    links.new(split.outputs["X"], factor.inputs[0])
+    factor.inputs[1].default_value = 1.0 / (hi - lo)
+    factor.inputs[2].default_value = -lo / (hi - lo)
+    sample = nodes.new("GeometryNodeSampleCurve")
+    links.new(info.outputs["Geometry"], sample.inputs[0])
+    links.new(factor.outputs[0], sample.inputs["Factor"])
+    y = nodes.new("ShaderNodeMath")
+    y.operation = "SUBTRACT"
+    links.new(split.outputs["Y"], y.inputs[0])
+    y.inputs[1].default_value = y0
+    z = nodes.new("ShaderNodeMath")
+    z.operation = "SUBTRACT"
+    links.new(split.outputs["Z"], z.inputs[0])
+    z.inputs[1].default_value = z0
+    binormal = nodes.new("ShaderNodeVectorMath")
+    binormal.operation = "CROSS_PRODUCT"
+    links.new(sample.outputs["Tangent"], binormal.inputs[0])
+    links.new(sample.outputs["Normal"], binormal.inputs[1])
+    along_n = nodes.new("ShaderNodeVectorMath")
+    along_n.operation = "SCALE"
+    links.new(sample.outputs["Normal"], along_n.inputs[0])
+    links.new(y.outputs[0], along_n.inputs["Scale"])
+    along_b = nodes.new("ShaderNodeVectorMath")
+    along_b.operation = "SCALE"
+    links.new(binormal.outputs[0], along_b.inputs[0])
+    links.new(z.outputs[0], along_b.inputs["Scale"])
+    offset = nodes.new("ShaderNodeVectorMath")
+    offset.operation = "ADD"
+    links.new(along_n.outputs[0], offset.inputs[0])
+    links.new(along_b.outputs[0], offset.inputs[1])
+    moved = nodes.new("ShaderNodeVectorMath")
+    moved.operation = "ADD"
+    links.new(sample.outputs["Position"], moved.inputs[0])
+    links.new(offset.outputs[0], moved.inputs[1])
+    set_position = nodes.new("GeometryNodeSetPosition")
+    links.new(group_in.outputs[0], set_position.inputs["Geometry"])
+    links.new(moved.outputs[0], set_position.inputs["Position"])
+    links.new(set_position.outputs[0], group_out.inputs[0])
+    return group
+
+
+def make_geometry_nodes(scene, mesh, axes, rest_axis):
+    curve = animated_axis_curve(scene, axes)
+    obj = add_object(scene, "fish_gn", mesh)
+    modifier = obj.modifiers.new("Bend", "NODES")
+    modifier.node_group = gn_bend_group(curve, rest_axis)
+    return obj
+
+
+def make_curve_modifier(scene, mesh, axes):
+    curve = animated_axis_curve(scene, axes)
+    obj = add_object(scene, "fish_curve", mesh)
+    modifier = obj.modifiers.new("Curve", "CURVE")
     modifier.object = curve
     modifier.deform_axis = "POS_X"
-    obj.kodawari_swim.enabled = False
-    obj.hide_viewport = True
-    depsgraph = bpy.context.evaluated_depsgraph_get()
-    times = []
-    for frame in range(FRAMES + 1):
-        ys = 0.08 * np.sin(2 * np.pi * (xs + 0.1 * frame))
-        co = np.stack([xs, ys, np.zeros(16), np.ones(16)], axis=1).astype(np.float32)
-        spline.points.foreach_set("co", co.reshape(-1))
-        curve_data.update_tag()
-        t = time.perf_counter()
-        depsgraph.update()
-        _ = copy.evaluated_get(depsgraph).data.vertices[0].co  # the modifier has run
-        if frame:
-            times.append(time.perf_counter() - t)
-    obj.hide_viewport = False
-    obj.kodawari_swim.enabled = True
-    copy.hide_viewport = True
-    return float(np.median(times))
+    return obj
+
+
+def make_floor(scene, mesh, frames):
+    obj = add_object(scene, "fish_floor", mesh)
+    obj.shape_key_add(name="Basis")
+    pulse = obj.shape_key_add(name="Pulse")
+    count = len(mesh.vertices)
+    co = np.empty(count * 3, np.float32)
+    mesh.vertices.foreach_get("co", co)
+    (getattr(pulse, "points", None) or pulse.data).foreach_set("co", co * 1.02)
+    for frame in frames:
+        pulse.value = frame % 2
+        pulse.keyframe_insert("value", frame=frame)
+    return obj
+
+
+def build_side(side, scene, ring, rings, axes=None, rest_axis=None, frames=(), mesh=None):
+    """One side's objects in `scene`, on a new body mesh (or on `mesh`, a plain copy of it)."""
+    if mesh is None:
+        mesh = fish_body_mesh(f"body_{side}", ring, rings)
+    if side == "kodawari":
+        return make_kodawari(scene, mesh)
+    if side == "geometry_nodes":
+        return make_geometry_nodes(scene, mesh, axes, rest_axis)
+    if side == "curve_modifier":
+        return make_curve_modifier(scene, mesh, axes)
+    return make_floor(scene, mesh, frames)
+
+
+# ----------------------------------------------------------------------------- one frame
+
+
+def whole_frame(scene, obj, frame):
+    """What a viewport does per frame: frame_set, evaluate what handlers tagged, read normals.
+    Returns the tail vertex of the evaluated mesh (to check that it moves)."""
+    scene.frame_set(frame)
+    depsgraph = scene.view_layers[0].depsgraph
+    depsgraph.update()
+    mesh = obj.evaluated_get(depsgraph).data
+    normal = mesh.vertices[0].normal
+    return tuple(mesh.vertices[len(mesh.vertices) - 1].co) + tuple(normal)
+
+
+def player(scene, obj, frames):
+    def play(_round):
+        whole_frame(scene, obj, 1)  # untimed: every round plays the same frames from the same start
+        seconds = []
+        for frame in frames:
+            start = time.perf_counter()
+            whole_frame(scene, obj, frame)
+            seconds.append(time.perf_counter() - start)
+        return seconds
+
+    return play
+
+
+def moves(scene, obj, frames):
+    return len({whole_frame(scene, obj, f) for f in frames[:2]}) > 1
+
+
+# ----------------------------------------------------------------------------- child: one side's memory
+
+
+def child(spec):
+    bpy.ops.wm.read_homefile(use_empty=True)
+    scene = bpy.context.scene
+    scene.render.fps = 24
+    gc.collect()
+    start = benchlib.rss_mb()
+    axes = {int(k): v for k, v in spec["axes"].items()}
+    frames = list(range(1, spec["frames"] + 2))
+    obj = build_side(
+        spec["side"], scene, spec["ring"], spec["rings"], axes, spec["rest_axis"], frames
+    )
+    gc.collect()
+    build_peak = benchlib.peak_rss_mb()
+    benchlib.reset_peak_rss()  # from here: the peak while playing
+    for frame in frames:
+        whole_frame(scene, obj, frame)
+    play_peak = benchlib.peak_rss_mb()
+    benchlib.child_report(
+        {
+            "peak_rss_mb": round(max(build_peak, play_peak), 1),
+            "above_start_mb": round(play_peak - start, 1),
+            "play_peak_mb": round(play_peak, 1),
+            "build_peak_mb": round(build_peak, 1),
+            "start_mb": round(start, 1),
+        }
+    )
+
+
+# ----------------------------------------------------------------------------- parent
+
+
+def solver_alone(obj, scene, frames):
+    """The add-on's own per-frame work without Blender's evaluation: runtime.evaluate
+    (phase, native FFD deform, shape key write) and the native deform alone."""
+    from kodawari.fish import runtime
+
+    rig = runtime.get_rig(obj)
+    evaluate, deform = [], []
+    for _ in range(benchlib.ROUNDS):
+        evaluate.append(
+            np.mean([benchlib.timed(lambda f=f: runtime.evaluate(obj, scene, f)) for f in frames])
+        )
+        deform.append(
+            np.mean(
+                [
+                    benchlib.timed(lambda: rig.binding.deform(rig.axis, rig.positions))
+                    for _ in frames
+                ]
+            )
+        )
+    return {
+        "handler_ms_min": round(min(evaluate) * 1e3, 3),
+        "handler_ms_median": round(float(np.median(evaluate)) * 1e3, 3),
+        "deform_ms_min": round(min(deform) * 1e3, 3),
+        "deform_ms_median": round(float(np.median(deform)) * 1e3, 3),
+    }
+
+
+def measure_size(count, ring, rings, per_round):
+    bpy.ops.wm.read_homefile(use_empty=True)
+    main_scene = bpy.context.scene
+    main_scene.render.fps = 24
+    frames = list(range(2, per_round + 2))
+    all_frames = [1, *frames]
+    t = time.perf_counter()
+    objects, scenes = {}, {}
+    scenes["kodawari"] = main_scene
+    body = fish_body_mesh(
+        "body", ring, rings
+    )  # the other sides bend copies of it (faster than rebuilding)
+    objects["kodawari"] = build_side("kodawari", main_scene, ring, rings, mesh=body.copy())
+    axes, rest_axis = fish_axes(objects["kodawari"], main_scene, all_frames)
+    for side in SIDES[1:]:
+        scenes[side] = new_scene(side)
+        objects[side] = build_side(
+            side, scenes[side], ring, rings, axes, rest_axis, all_frames, mesh=body.copy()
+        )
+    bpy.data.meshes.remove(body)
+    setup = time.perf_counter() - t
+    moved = {side: moves(scenes[side], objects[side], frames) for side in SIDES}
+    plays = {side: player(scenes[side], objects[side], frames) for side in SIDES}
+    rows = benchlib.Rounds().run(plays)
+    solver = solver_alone(objects["kodawari"], main_scene, frames)
+    process_peak = benchlib.peak_rss_mb()
+    del objects, scenes
+    bpy.ops.wm.read_homefile(use_empty=True)  # free this size before its children run
+    for side in SIDES:
+        memory = benchlib.run_child(
+            __file__,
+            {
+                "side": side,
+                "ring": ring,
+                "rings": rings,
+                "frames": per_round,
+                "axes": axes,
+                "rest_axis": rest_axis,
+            },
+        )
+        rows[side].update(memory)
+        rows[side]["moves"] = moved[side]
+        rows[side]["vertices"] = ring * rings
+        rows[side]["frames_per_round"] = per_round
+    return {
+        "vertices": ring * rings,
+        "rows": rows,
+        "solver": solver,
+        "setup_s": round(setup, 1),
+        "timing_process_peak_mb": round(process_peak, 1),
+    }
 
 
 def main():
-    bpy.ops.wm.read_homefile(use_empty=True, use_factory_startup=True)
-    scene = bpy.context.scene
-    scene.render.fps = 24
-
-    t = time.perf_counter()
-    big = _fish(rings=1000, segments=1000, fins=True)
-    n_big = len(big.data.vertices)
-    print(f"built and bound a {n_big:,}-vertex fish in {time.perf_counter() - t:.1f} s")
-    kernel, full = _time_ours(big)
-    floor = _time_blender_floor(big)
-    curve = _time_curve_modifier(big)
     print(
-        f"1M fish, ours (kernel + write): {kernel * 1e3:8.1f} ms/frame  ({kernel / n_big * 1e9:6.1f} ns/vertex)"
+        f"=== fish, whole frame ({benchlib.blender_label()}, {os.cpu_count()} CPUs, load {benchlib.load()}): "
+        f"ms per frame min / median of {benchlib.ROUNDS} rounds; peak RSS per side in its own process"
     )
-    print(f"1M fish, ours (frame):          {full * 1e3:8.1f} ms/frame")
-    print(
-        f"1M fish, Curve modifier:        {curve * 1e3:8.1f} ms/frame  ({curve / n_big * 1e9:6.1f} ns/vertex)"
-    )
-    print(f"ratio Curve modifier / ours (kernel + write): {curve / kernel:5.1f}x   (target >= 10x)")
-    print(f"1M fish, Blender's own mesh update (no deformer): {floor * 1e3:6.1f} ms/frame")
-    print(f"ratio Curve modifier / ours (frame):          {curve / full:5.1f}x")
-    print(
-        f"ratio (Curve modifier - floor) / ours (kernel + write): {(curve - floor) / kernel:5.1f}x"
-    )
-    bpy.data.objects.remove(big)
+    results = []
+    for count, (ring, rings, per_round) in benchlib.sizes(SIZES).items():
+        size = measure_size(count, ring, rings, per_round)
+        results.append(size)
+        rows = size["rows"]
+        ours = rows["kodawari"]
+        print(
+            f"  {size['vertices']:>9,} vertices ({per_round} frames/round, set-up {size['setup_s']} s):"
+        )
+        for side in SIDES:
+            row = rows[side]
+            ratio = (
+                ""
+                if side == "kodawari"
+                else f"  kodawari / this {ours['ms_median'] / row['ms_median']:5.2f}x"
+            )
+            mem_ratio = ""
+            if side != "kodawari" and row.get("above_start_mb") and ours.get("above_start_mb"):
+                mem_ratio = f"  mem {ours['above_start_mb'] / row['above_start_mb']:4.2f}x"
+            err = f"  [memory child: {row['error']}]" if "error" in row else ""
+            print(
+                f"    {side:15s} {benchlib.fmt_ms(row)}  {benchlib.fmt_mem(row)}  load {row['load']:4.1f}"
+                f"{ratio}{mem_ratio}{'' if row['moves'] else '  (DID NOT MOVE)'}{err}"
+            )
+        s = size["solver"]
+        print(
+            f"    solver alone: handler (phase + FFD + write) {s['handler_ms_min']:.2f} / {s['handler_ms_median']:.2f} ms,"
+            f" native deform {s['deform_ms_min']:.2f} / {s['deform_ms_median']:.2f} ms"
+            f" = {s['deform_ms_min'] * 1e6 / size['vertices']:.2f} ns/vertex"
+        )
+        benchlib.record("fish", results)
 
-    small = _fish(rings=320, segments=310, fins=True)
-    n_small = len(small.data.vertices)
-    kernel, full = _time_ours(small)
-    print(
-        f"{n_small:,}-vertex fish, ours (kernel + write): {kernel * 1e3:6.2f} ms/frame (target < 10 ms)"
-    )
-    print(f"{n_small:,}-vertex fish, ours (frame):          {full * 1e3:6.2f} ms/frame")
 
-
-main()
+if __name__ == "__main__":
+    spec = benchlib.child_spec()
+    if spec is not None:
+        child(spec)
+    else:
+        main()

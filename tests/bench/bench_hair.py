@@ -1,31 +1,43 @@
-"""Benchmark: view-dependent hair in Blender, end to end per frame.
+"""Hair, whole frame against whole frame (run by tools/run_bench.sh in every Blender; prints
+figures, never fails on time; writes out/bench.json -> hair).
 
-1,000 chains x 16 bones on one armature. Per frame the add-on reads every pose-bone
-matrix (the kinematic parents), simulates 4 substeps of every rod in C++ and writes every
-rod bone's rotation: µs per bone per frame (target <= 1 µs). In the same process, a
-pure-Python per-bone spring in the style of Wiggle 2 (our own simple step: one Verlet
-spring per bone, length kept, rotation written per bone) over chains of the same rig,
-and the ratio. Also the native cost per particle-substep. Figures, never pass/fail.
-Run: tools/run_bench.sh (Blender 3.4 with the add-on installed).
+An armature of CHAINS chains x 16 connected bones under an animated "Head" bone (160, 1,600
+and 16,000 chain bones). Per frame, every side gets what a viewport does: `scene.frame_set(f)`
+then the depsgraph evaluates whatever the frame handlers tagged.
+
+  kodawari      the add-on's live hair (every chain a rod, 4 substeps per frame)
+  bare          the same rig with the hair switched off: Blender's own evaluation, the floor
+  wiggle2_port  a same-process port of Wiggle 2's algorithm (see wiggle2_port.py: Wiggle 2
+                itself cannot be installed on this machine), every chain bone's tail wiggling
+
+Sides are timed interleaved round by round in one process; each round starts at the scene's
+first frame (every side resets there) and plays the following frames. Peak memory per side
+comes from its own child process.
 """
 
 import math
 import os
+import sys
 import time
 
 import bpy
 import numpy as np
 from mathutils import Vector
 
-from kodawari.hair import chains, runtime
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import benchlib
 
-CHAINS, BONES, SUBSTEPS = 1000, 16, 4
+print = benchlib.say  # each line at once, also through a pipe
+import wiggle2_port  # noqa: E402
+
+BONES, SUBSTEPS = 16, 4
 BONE_LENGTH = 0.02
-FRAMES = 48
-BASELINE_CHAINS = 100
+# chain bones -> (chains, frames per round for kodawari and bare, frames per round for the port)
+SIZES = {160: (10, 12, 6), 1_600: (100, 8, 3), 16_000: (1000, 4, 1)}
+SIDES = ("kodawari", "bare", "wiggle2_port")
 
 
-def build_rig(scene):
+def build_rig(scene, chain_count):
     data = bpy.data.armatures.new("Bench")
     obj = bpy.data.objects.new("Bench", data)
     scene.collection.objects.link(obj)
@@ -33,8 +45,8 @@ def build_rig(scene):
     bpy.ops.object.mode_set(mode="EDIT")
     head = data.edit_bones.new("Head")
     head.head, head.tail = (0, 0, 1.5), (0, 0, 1.8)
-    side = int(math.ceil(math.sqrt(CHAINS)))
-    for c in range(CHAINS):
+    side = math.ceil(math.sqrt(chain_count))
+    for c in range(chain_count):
         x, y = (c % side - side / 2) * 0.01, (c // side - side / 2) * 0.01
         parent, position = head, Vector((x, y, 1.8))
         for b in range(BONES):
@@ -43,136 +55,181 @@ def build_rig(scene):
             bone.parent, bone.use_connect = parent, b > 0
             parent, position = bone, position + Vector((0.0, 0.0, BONE_LENGTH))
     bpy.ops.object.mode_set(mode="POSE")
+    from kodawari.hair import chains
+
     for pb in obj.pose.bones:
         chains.set_selected(pb, pb.name.endswith(".00"))
     assert bpy.ops.kodawari.rod_add() == {"FINISHED"}
     for rod in obj.kodawari_hair.rods:
-        rod.substeps = SUBSTEPS  # 4 substeps per frame at 24 fps
+        rod.substeps = SUBSTEPS
     head_pb = obj.pose.bones["Head"]
-    for frame, location in ((1, (0, 0, 0)), (12, (0.2, 0, 0.05)), (24, (-0.2, 0.1, 0)), (36, (0, 0, 0)),
-                            (48, (0.1, -0.1, 0))):
+    for frame, location in (
+        (1, (0, 0, 0)),
+        (6, (0.2, 0, 0.05)),
+        (12, (-0.2, 0.1, 0)),
+        (18, (0, 0, 0)),
+        (24, (0.1, -0.1, 0)),
+    ):
         head_pb.location = location
         head_pb.keyframe_insert("location", frame=frame)
+    bpy.ops.object.mode_set(mode="OBJECT")
     return obj
 
 
-def bench_kodawari(scene, obj):
-    obj.kodawari_hair.enabled = False  # the handler stays out: we time the same work directly
-    rt = runtime.ArmatureRuntime(obj)
-    assert rt.system.rod_count == CHAINS and not rt.error
-    per_frame, per_frame_cpu = [], []
-    for frame in range(1, FRAMES + 1):
-        scene.frame_set(frame)  # Blender evaluates the armature (not counted)
-        t0, c0 = time.perf_counter(), time.process_time()
-        rt.evaluate(obj, scene, frame)  # read parents, 4 substeps for every rod, write rotations
-        per_frame.append(time.perf_counter() - t0)
-        per_frame_cpu.append(time.process_time() - c0)
-    steady = np.array(per_frame[1:])  # frame 1 is a reset, not a step
-    steady_cpu = np.array(per_frame_cpu[1:])
-    # The native step alone, on the same inputs (advances the state: fine for timing).
-    armature = np.array([tuple(r) for r in obj.matrix_world], np.float64)
-    camera = np.array([0.0, -5.0, 1.7])
-    gravity = np.array([0.0, 0.0, -9.81])
-    native, native_cpu = [], []
-    for i in range(20):
-        t0, c0 = time.perf_counter(), time.process_time()
-        rt.system.step(rt.matrices, armature, camera, gravity, 3.0 + i / 24, 1 / 24, rt.rotations)
-        native.append(time.perf_counter() - t0)
-        native_cpu.append(time.process_time() - c0)
-    # Whole frame including Blender's own pose evaluation of all bones, with the live handler.
-    obj.kodawari_hair.enabled = True
-    scene.frame_set(1)
-    full = []
-    for frame in range(2, 26):
-        t0 = time.perf_counter()
-        scene.frame_set(frame)
-        full.append(time.perf_counter() - t0)
+def chain_bones(obj):
+    return [pb for pb in obj.pose.bones if pb.name != "Head"]
+
+
+class Sides:
+    """Switches the rig between the three sides."""
+
+    def __init__(self, scene, obj):
+        self.scene, self.obj = scene, obj
+        self.wiggle = wiggle2_port.WigglePort(scene, obj, chain_bones(obj))
+
+    def use(self, side):
+        self.obj.kodawari_hair.enabled = side == "kodawari"
+        if side == "wiggle2_port":
+            self.wiggle.install()
+        else:
+            self.wiggle.uninstall()
+
+    def frame(self, frame):
+        self.scene.frame_set(frame)
+        self.scene.view_layers[0].depsgraph.update()
+
+    def player(self, side, frames):
+        def play(_round):
+            self.use(side)
+            self.frame(1)  # every side resets at the first frame (untimed)
+            if side == "wiggle2_port":
+                self.wiggle.reset()
+            seconds = []
+            for frame in frames:
+                start = time.perf_counter()
+                self.frame(frame)
+                seconds.append(time.perf_counter() - start)
+            self.use(None)
+            return seconds
+
+        return play
+
+
+def child(spec):
+    bpy.ops.wm.read_homefile(use_empty=True)
+    scene = bpy.context.scene
+    start = benchlib.rss_mb()
+    obj = build_rig(scene, spec["chains"])
+    sides = Sides(scene, obj)
+    build_peak = benchlib.peak_rss_mb()
+    benchlib.reset_peak_rss()  # from here: the peak while playing
+    sides.player(spec["side"], list(range(2, spec["frames"] + 2)))(0)
+    play_peak = benchlib.peak_rss_mb()
+    benchlib.child_report(
+        {
+            "peak_rss_mb": round(max(build_peak, play_peak), 1),
+            "above_start_mb": round(play_peak - start, 1),
+            "play_peak_mb": round(play_peak, 1),
+            "build_peak_mb": round(build_peak, 1),
+            "start_mb": round(start, 1),
+        }
+    )
+
+
+def solver_alone(scene, obj, frames):
+    """The add-on's handler alone (read parents, native step, write rotations) and the native
+    step alone, on frames after a real frame_set (Blender's evaluation not counted)."""
+    from kodawari.hair import runtime
+
     obj.kodawari_hair.enabled = False
-    scene.frame_set(1)
-    baseline_frame = []
-    for frame in range(2, 26):
-        t0 = time.perf_counter()
-        scene.frame_set(frame)
-        baseline_frame.append(time.perf_counter() - t0)
-    return {"add_on": np.median(steady), "add_on_mean": steady.mean(), "add_on_cpu": np.median(steady_cpu),
-            "native": np.median(native), "native_cpu": np.median(native_cpu), "full": np.median(full),
-            "blender_only": np.median(baseline_frame)}
+    rt = runtime.ArmatureRuntime(obj)
+    handler, native = [], []
+    for _ in range(benchlib.ROUNDS):
+        scene.frame_set(1)
+        rt.evaluate(obj, scene, 1)
+        times = []
+        for frame in frames:
+            scene.frame_set(frame)
+            times.append(benchlib.timed(lambda f=frame: rt.evaluate(obj, scene, f)))
+        handler.append(np.mean(times))
+        armature = np.array([tuple(r) for r in obj.matrix_world], np.float64)
+        camera, gravity = np.array([0.0, -5.0, 1.7]), np.array([0.0, 0.0, -9.81])
+
+        def step(i, armature=armature, camera=camera, gravity=gravity):
+            rt.system.step(
+                rt.matrices, armature, camera, gravity, 3.0 + i / 24, 1 / 24, rt.rotations
+            )
+
+        native.append(np.mean([benchlib.timed(lambda i=i: step(i)) for i in range(len(frames))]))
+    return {
+        "handler_ms_min": round(min(handler) * 1e3, 3),
+        "handler_ms_median": round(float(np.median(handler)) * 1e3, 3),
+        "step_ms_min": round(min(native) * 1e3, 3),
+        "step_ms_median": round(float(np.median(native)) * 1e3, 3),
+    }
 
 
-class PythonJiggle:
-    """A per-bone Python spring (the approach of pure-Python jiggle add-ons such as Wiggle 2,
-    written here from scratch): one Verlet step per bone per frame, pulled towards the bone's
-    rest direction under its parent, length restored, rotation written per bone."""
-
-    def __init__(self, obj, chain_count):
-        self.obj = obj
-        self.chains = []
-        for c in range(chain_count):
-            bones = [obj.pose.bones[f"C{c:04d}.{b:02d}"] for b in range(BONES)]
-            self.chains.append(bones)
-        self.state = {}
-
-    def step(self, dt=1 / 24, stiffness=0.3, damping=0.1, gravity=Vector((0.0, 0.0, -9.81))):
-        for bones in self.chains:
-            parent_matrix = bones[0].parent.matrix.copy()
-            rest_parent = bones[0].parent.bone.matrix_local
-            for pb in bones:
-                rest_local = rest_parent.inverted() @ pb.bone.matrix_local
-                frame = parent_matrix @ rest_local  # the bone's rest frame under its (moving) parent
-                head = frame.translation
-                target = frame @ Vector((0.0, pb.bone.length, 0.0))
-                position, previous = self.state.get(pb.name, (target.copy(), target.copy()))
-                velocity = (position - previous) * (1.0 - damping)
-                new = position + velocity + gravity * dt * dt + (target - position) * stiffness
-                new = head + (new - head).normalized() * pb.bone.length
-                self.state[pb.name] = (new, position)
-                direction = frame.to_3x3().inverted() @ (new - head)
-                q = Vector((0.0, 1.0, 0.0)).rotation_difference(direction)
-                pb.rotation_quaternion = q
-                parent_matrix = frame @ q.to_matrix().to_4x4()
-                rest_parent = pb.bone.matrix_local
-
-
-def bench_python(scene, obj):
-    jiggle = PythonJiggle(obj, BASELINE_CHAINS)
-    times = []
-    for frame in range(1, 25):
-        scene.frame_set(frame)
-        t0 = time.perf_counter()
-        jiggle.step()
-        times.append(time.perf_counter() - t0)
-    return np.median(times[1:])
+def measure_size(bones, chain_count, frames_ours, frames_port):
+    bpy.ops.wm.read_homefile(use_empty=True)
+    scene = bpy.context.scene
+    scene.frame_start, scene.frame_end = 1, 250
+    t = time.perf_counter()
+    obj = build_rig(scene, chain_count)
+    sides = Sides(scene, obj)
+    setup = time.perf_counter() - t
+    frames = {
+        side: list(range(2, (frames_port if side == "wiggle2_port" else frames_ours) + 2))
+        for side in SIDES
+    }
+    rows = benchlib.Rounds().run({side: sides.player(side, frames[side]) for side in SIDES})
+    solver = solver_alone(scene, obj, frames["kodawari"])
+    for side in SIDES:
+        memory = benchlib.run_child(
+            __file__, {"side": side, "chains": chain_count, "frames": len(frames[side])}
+        )
+        rows[side].update(memory)
+        rows[side]["bones"] = bones
+        rows[side]["frames_per_round"] = len(frames[side])
+    return {"bones": bones, "rows": rows, "solver": solver, "setup_s": round(setup, 1)}
 
 
 def main():
-    bpy.ops.wm.read_homefile(use_empty=True)
-    scene = bpy.context.scene
-    load_before = os.getloadavg()[0]
-    t0 = time.perf_counter()
-    obj = build_rig(scene)
-    bones = CHAINS * BONES
-    print(f"set-up: {CHAINS} chains x {BONES} bones ({bones} rod bones) in {time.perf_counter() - t0:.1f} s")
-    k = bench_kodawari(scene, obj)
-    python = bench_python(scene, obj)
-    python_bones = BASELINE_CHAINS * BONES
-    per_bone = k["add_on"] / bones * 1e6
-    per_bone_python = python / python_bones * 1e6
-    particle_substeps = CHAINS * BONES * SUBSTEPS
-    print(f"kodawari, end to end per frame (read parents, {SUBSTEPS} substeps, write rotations): "
-          f"{k['add_on'] * 1e3:.2f} ms = {per_bone:.3f} us per bone per frame (target <= 1 us); "
-          f"mean {k['add_on_mean'] * 1e3:.2f} ms; CPU time (all threads) {k['add_on_cpu'] * 1e3:.2f} ms")
-    print(f"  native step alone: {k['native'] * 1e3:.2f} ms = {k['native'] / particle_substeps * 1e9:.1f} ns per "
-          f"particle-substep ({particle_substeps} particle-substeps per frame, {os.cpu_count()} hardware threads); "
-          f"CPU time {k['native_cpu'] * 1e3:.2f} ms = {k['native_cpu'] / particle_substeps * 1e9:.1f} ns of CPU "
-          f"per particle-substep")
-    print(f"  whole frame_set with the live handler (incl. Blender's own pose evaluation): {k['full'] * 1e3:.1f} ms; "
-          f"without it: {k['blender_only'] * 1e3:.1f} ms")
-    print(f"pure-Python per-bone spring (Wiggle 2 style, 1 step per frame) over {python_bones} bones: "
-          f"{python * 1e3:.1f} ms = {per_bone_python:.1f} us per bone per frame")
-    print(f"ratio: kodawari is {per_bone_python / per_bone:.0f}x faster per bone per frame "
-          f"(Wiggle 2 itself was measured at about 115 us per bone per frame: {115 / per_bone:.0f}x)")
-    print(f"machine load (1-min load average) before / after: {load_before:.1f} / {os.getloadavg()[0]:.1f} "
-          f"on {os.cpu_count()} hardware threads: wall-clock figures grow with it, CPU times much less")
+    print(
+        f"=== hair, whole frame ({benchlib.blender_label()}, {os.cpu_count()} CPUs, load {benchlib.load()}): "
+        f"ms per frame min / median of {benchlib.ROUNDS} rounds; peak RSS per side in its own process"
+    )
+    results = []
+    for bones, (chain_count, frames_ours, frames_port) in benchlib.sizes(SIZES).items():
+        size = measure_size(bones, chain_count, frames_ours, frames_port)
+        results.append(size)
+        rows = size["rows"]
+        ours, bare = rows["kodawari"], rows["bare"]
+        print(f"  {bones:>6,} chain bones ({chain_count} chains, set-up {size['setup_s']} s):")
+        for side in SIDES:
+            row = rows[side]
+            if side == "kodawari":
+                ratio = f"  this / bare {row['ms_median'] / bare['ms_median']:5.2f}x"
+            elif side == "bare":
+                ratio = ""
+            else:
+                ratio = f"  this / kodawari {row['ms_median'] / ours['ms_median']:7.1f}x"
+            err = f"  [memory child: {row['error']}]" if "error" in row else ""
+            print(
+                f"    {side:13s} {benchlib.fmt_ms(row)}  {benchlib.fmt_mem(row)}  load {row['load']:4.1f}"
+                f"  ({row['frames_per_round']} frames/round){ratio}{err}"
+            )
+        s = size["solver"]
+        print(
+            f"    solver alone: handler (read, step, write) {s['handler_ms_min']:.2f} / {s['handler_ms_median']:.2f} ms"
+            f" = {s['handler_ms_min'] * 1e3 / bones:.2f} us/bone; native step {s['step_ms_min']:.2f} /"
+            f" {s['step_ms_median']:.2f} ms"
+        )
+        benchlib.record("hair", results)
 
 
-main()
+if __name__ == "__main__":
+    spec = benchlib.child_spec()
+    if spec is not None:
+        child(spec)
+    else:
+        main()

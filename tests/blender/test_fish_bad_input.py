@@ -156,7 +156,7 @@ def test_bake_with_reversed_frame_range(empty_scene, tmp_path):
     _refused(
         bpy.ops.kodawari.swim_bake,
         obj,
-        ["end frame 3 comes before the start frame 10"],
+        ["end frame 3 is before start frame 10"],
         frame_start=10,
         frame_end=3,
         filepath=str(tmp_path / "x.pc2"),
@@ -165,7 +165,7 @@ def test_bake_with_reversed_frame_range(empty_scene, tmp_path):
 
 
 def test_bake_cancel_leaves_everything_as_it_was(empty_scene, tmp_path):
-    """Esc during a modal bake runs Baker.cancel(): no file, no key, no modifier, same frame."""
+    """Esc during a modal bake runs the job's cancel(): no file, no key, no modifier, same frame."""
     from kodawari.fish import bake
 
     obj = make_fish("tuna")
@@ -174,8 +174,8 @@ def test_bake_cancel_leaves_everything_as_it_was(empty_scene, tmp_path):
     scene.frame_set(4)
     before = _snapshot(obj)
     for target in ("MESH_CACHE", "SHAPE_KEYS"):
-        baker = bake.Baker(obj, scene, 1, 10, target, str(tmp_path / "c.pc2"))
-        baker.start()
+        baker = bake.SwimBakeJob(obj, scene, 1, 10, target, str(tmp_path / "c.pc2"))
+        baker.prepare()
         for _ in range(5):
             baker.step()
         baker.cancel()

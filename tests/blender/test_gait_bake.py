@@ -94,12 +94,16 @@ def test_steady_gait_measured_from_the_action_matches_the_table(empty_scene, gai
     seg = _steady(rig, fps, 5)
     assert seg["gait"] == gait
     entry = s.table[gait]
-    phases = native.module().gait_leg_phases(rigmod.table_dict(s), GAITS.index(gait))
+    kn = native.module()
+    table = rigmod.table_dict(s)
+    phases = kn.gait_leg_phases(table, GAITS.index(gait))
+    # the duty factor at this speed (the gallop's falls with speed)
+    duty = kn.gait_duty_factor(table, GAITS.index(gait), speed, 1.4)
     for k, leg in enumerate(("LF", "RF", "LH", "RH")):
         got = seg["legs"][leg]
-        assert abs(got["duty_factor"] - entry.duty_factor) < 0.03, (leg, got["duty_factor"])
+        assert abs(got["duty_factor"] - duty) < 0.03, (leg, got["duty_factor"])
         assert abs((got["phase"] - phases[k] + 0.5) % 1 - 0.5) < 0.03, (leg, got["phase"], phases[k])
-        assert got["stride"] == pytest.approx(speed * entry.swing_time / (1 - entry.duty_factor), rel=0.01)
+        assert got["stride"] == pytest.approx(speed * entry.swing_time / (1 - duty), rel=0.01)
         assert got["largest_stance_slide"] < 0.005
 
 
@@ -145,7 +149,7 @@ def test_bad_input_is_refused_and_changes_nothing(empty_scene, case, message):
     bpy.ops.kodawari.gait_bake(frame_start=1, frame_end=40)  # an earlier bake to protect
     s = rig.kodawari_gait
     if case == "negative":
-        from kodawari.gait import samples
+        import gait_samples as samples
         samples.key_speed(rig, [(20, -1.0)])
     elif case == "too_fast":
         s.speed = 40.0

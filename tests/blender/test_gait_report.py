@@ -69,3 +69,24 @@ def test_loading_a_file_rebuilds_runtime_state(empty_scene, tmp_path):
     out = str(tmp_path / "again.png")
     bpy.context.view_layer.objects.active = rig
     assert bpy.ops.kodawari.gait_report(filepath=out) == {"FINISHED"}  # measured from the saved Action
+
+
+def test_report_measures_what_blender_shows_not_the_keys(empty_scene, tmp_path):
+    """A constraint that holds the body back (another action, a rig's own constraint):
+    the keys are unchanged, but in Blender the planted feet are dragged along. The report
+    measures the evaluated pose, so it shows the slide."""
+    rig = horse(empty_scene, [(1, 2.0), (72, 2.0)])
+    for child in list(rig.children):
+        bpy.data.objects.remove(child)
+    assert bpy.ops.kodawari.gait_bake(frame_start=1, frame_end=72) == {"FINISHED"}
+    out = str(tmp_path / "r.png")
+    assert bpy.ops.kodawari.gait_report(filepath=out) == {"FINISHED"}
+    clean = json.load(open(str(tmp_path / "r.json")))["segments"]
+    assert max(s["largest_stance_slide"] for s in clean) < 0.005
+    limit = rig.pose.bones["body"].constraints.new("LIMIT_LOCATION")
+    limit.use_min_y = limit.use_max_y = True
+    limit.min_y = limit.max_y = 0.0  # the body stays put; the legs still step
+    limit.owner_space = "LOCAL"
+    assert bpy.ops.kodawari.gait_report(filepath=out) == {"FINISHED"}
+    held = json.load(open(str(tmp_path / "r.json")))["segments"]
+    assert max(s["largest_stance_slide"] for s in held) > 0.05

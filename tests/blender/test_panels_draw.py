@@ -1,123 +1,95 @@
-"""Every Kodawari panel and list draws without error on every Blender.
+"""Every Kodawari panel and list draws without error on every Blender, in Blender's
+own layout (split labels with decorators), and shows only on objects that use its
+feature, with one "Add …" entry on the others.
 
-Background Blender never draws panels, so a draw() bug would only show in the UI.
-Here each panel's draw() runs against a recording layout that accepts only what
-the running Blender's UILayout offers, and checks every property and operator it
-names against RNA: a typo, or an API newer than this Blender, fails the test."""
+Background Blender never draws panels, so a draw() bug would only show in the UI;
+ui_recording.RecordingLayout runs draw() and checks every name against RNA."""
 
 import bpy
 import pytest
 from fish_helpers import add_swim, make_fish
 from gait_scene import horse
 from hair_rig import add_camera, make_rig, select_only
+from ui_recording import draw_body, kodawari_classes, showing_panels
 
-UILAYOUT_FUNCTIONS = set(bpy.types.UILayout.bl_rna.functions.keys())
-UILAYOUT_PROPERTIES = set(bpy.types.UILayout.bl_rna.properties.keys())
-
-
-def _has_property(data, name):
-    return name in data.bl_rna.properties or (isinstance(data, bpy.types.ID) and name in data.keys())
+SETTINGS_PANELS = {"KODAWARI_PT_swim": "swim", "KODAWARI_PT_hair": "hair", "KODAWARI_PT_gait": "gait"}
 
 
-class OperatorCall:
-    def __init__(self, idname):
-        module, name = idname.split(".")
-        self.__dict__["_rna"] = getattr(getattr(bpy.ops, module), name).get_rna_type()
-
-    def __setattr__(self, name, value):
-        assert name in self._rna.properties, f"operator {self._rna.identifier} has no property {name!r}"
+def _settings_panels(prefix):
+    return [p for p in kodawari_classes(prefix) if not p.__name__.endswith("_add")]
 
 
-class RecordingLayout:
-    """Duck-types UILayout: checks names, records what would be drawn."""
-
-    def __init__(self, log):
-        self.__dict__["log"] = log
-
-    def __setattr__(self, name, value):
-        assert name in UILAYOUT_PROPERTIES, f"UILayout has no attribute {name!r} in this Blender"
-
-    def __getattr__(self, name):
-        assert name in UILAYOUT_FUNCTIONS, f"UILayout has no function {name!r} in this Blender"
-        return lambda *args, **kwargs: self._generic(name, args, kwargs)
-
-    def _generic(self, name, args, kwargs):
-        self.log.append(name)
-        return RecordingLayout(self.log)
-
-    def prop(self, data, name, **kwargs):
-        assert _has_property(data, name.strip('[]"')), f"{type(data).__name__} has no property {name!r}"
-        self.log.append(f"prop {name}")
-
-    def prop_search(self, data, name, search_data, search_name, **kwargs):
-        assert _has_property(data, name), f"{type(data).__name__} has no property {name!r}"
-        assert _has_property(search_data, search_name), f"{type(search_data).__name__} has no {search_name!r}"
-        self.log.append(f"prop_search {name}")
-
-    def operator(self, idname, **kwargs):
-        self.log.append(f"operator {idname}")
-        return OperatorCall(idname)
-
-    def template_list(self, list_type, list_id, data, name, active_data, active_name, **kwargs):
-        assert _has_property(data, name) and _has_property(active_data, active_name)
-        list_class = getattr(bpy.types, list_type)
-        for index, item in enumerate(getattr(data, name)):
-            call(list_class.draw_item, list_class, bpy.context, RecordingLayout(self.log), data, item, 0,
-                 active_data, active_name, index)
-        self.log.append(f"template_list {name}")
-
-
-def call(function, owner, context, layout, *args):
-    """Calls a Panel/UIList method on a stand-in instance (bpy classes cannot be instantiated)."""
-
-    class StandIn:
-        def __getattr__(self, name):
-            value = getattr(owner, name)
-            return value.__get__(self) if callable(value) and hasattr(value, "__get__") else value
-
-    stand_in = StandIn()
-    stand_in.layout = layout
-    return function(stand_in, context, *args) if not args else function(stand_in, context, layout, *args)
-
-
-def draw_panels(prefix):
-    panels = [getattr(bpy.types, name) for name in dir(bpy.types) if name.startswith(prefix)]
-    assert panels, f"no panel {prefix}* registered"
-    logs = {}
-    for panel in panels:
-        assert panel.poll(bpy.context), f"{panel.__name__} does not show for this object"
-        log = []
-        for method in ("draw_header", "draw"):
-            if hasattr(panel, method):
-                call(getattr(panel, method), panel, bpy.context, RecordingLayout(log))
-        logs[panel.__name__] = log
-    return logs
-
-
-def test_fish_panel_draws(empty_scene):
-    obj = make_fish("tuna")
-    add_swim(obj, fins=("fin_pectoral", "fin_dorsal"))
-    log = draw_panels("KODAWARI_PT_swim")["KODAWARI_PT_swim"]
-    assert "prop frequency" in log and "template_list fins" in log
-    assert any(entry.startswith("operator kodawari.swim_bake") for entry in log)
-
-
-def test_hair_panel_draws(empty_scene):
-    obj = make_rig(empty_scene)
-    add_camera(empty_scene, "Front", (0.0, -3.0, 1.7))
+def _hair_rig(scene):
+    obj = make_rig(scene)
+    add_camera(scene, "Front", (0.0, -3.0, 1.7))
     select_only(obj, {"Ahoge.00"})
     assert bpy.ops.kodawari.rod_add() == {"FINISHED"}
     assert bpy.ops.kodawari.rod_key_view(source="CAMERA") == {"FINISHED"}
-    log = draw_panels("KODAWARI_PT_hair")["KODAWARI_PT_hair"]
-    assert "template_list rods" in log and "template_list keys" in log
-    assert any(entry.startswith("operator kodawari.rod_bake") for entry in log)
+    assert bpy.ops.kodawari.rod_collider_add(bone="Ahoge.00") == {"FINISHED"}
+    return obj
 
 
-def test_gait_panel_draws(empty_scene):
-    horse(empty_scene, speeds=((1, 2.0), (48, 5.0)))
-    log = draw_panels("KODAWARI_PT_gait")["KODAWARI_PT_gait"]
-    assert "prop speed" in log
-    assert any(entry.startswith("operator kodawari.gait_bake") for entry in log)
+def _gait_horse(scene):
+    obj = horse(scene, speeds=((1, 2.0), (48, 5.0)))
+    bpy.context.view_layer.objects.active = obj
+    return obj
+
+
+def _all_entries(logs):
+    return [entry for log in logs.values() for entry in log]
+
+
+def test_fish_panels_draw(empty_scene):
+    obj = make_fish("tuna")
+    add_swim(obj, fins=("fin_pectoral", "fin_dorsal"))
+    logs = showing_panels("KODAWARI_PT_swim")
+    entries = _all_entries(logs)
+    assert "prop frequency" in entries and "template_list fins" in entries
+    assert any(e.startswith("operator kodawari.swim_bake") for e in entries)
+    assert "operator kodawari.swim_apply" in entries
+    assert "KODAWARI_PT_swim_add" not in logs
+
+
+def test_hair_panels_draw(empty_scene):
+    _hair_rig(empty_scene)
+    logs = showing_panels("KODAWARI_PT_hair")
+    entries = _all_entries(logs)
+    assert "template_list rods" in entries and "template_list keys" in entries
+    assert "template_list colliders" in entries
+    assert any(e.startswith("operator kodawari.rod_bake") for e in entries)
+    # Lists a user can read: "1 key", a labelled view direction, a labelled Add Rod, "+" on keys.
+    labels = [e.name for e in entries if e.kind == "label"]
+    assert "1 key" in labels and "1 keys" not in labels
+    assert "Ahoge.00" in labels, "the collider row names its bone"
+    direction = next(e for e in entries if e == "prop direction")
+    assert direction.kwargs.get("text"), "the view-direction ball has a label"
+    add_rod = next(e for e in entries if e == "operator kodawari.rod_add")
+    assert add_rod.kwargs.get("text") and "Add" in add_rod.kwargs["text"]
+    assert "menu KODAWARI_MT_hair_key_add" in entries
+
+
+def test_gait_panels_draw(empty_scene):
+    _gait_horse(empty_scene)
+    logs = showing_panels("KODAWARI_PT_gait")
+    entries = _all_entries(logs)
+    assert "prop speed" in entries
+    assert any(e.startswith("operator kodawari.gait_bake") for e in entries)
+    assert len(logs) >= 1 + 4 + 5, "rig, table, legs and one sub-panel per gait and per leg"
+
+
+@pytest.mark.parametrize("prefix", ["KODAWARI_PT_swim", "KODAWARI_PT_hair", "KODAWARI_PT_gait"])
+def test_settings_panels_use_split_layout(empty_scene, prefix):
+    """Every setting a panel draws has its label split off, with a keyframe decorator."""
+    {"KODAWARI_PT_swim": lambda: add_swim(make_fish("tuna"), fins=("fin_pectoral",)),
+     "KODAWARI_PT_hair": lambda: _hair_rig(empty_scene),
+     "KODAWARI_PT_gait": lambda: _gait_horse(empty_scene)}[prefix]()
+    panels = [p for p in _settings_panels(prefix) if p.poll(bpy.context)]
+    assert len(panels) >= 3, "advanced settings are in sub-panels"
+    assert any("DEFAULT_CLOSED" in getattr(p, "bl_options", ()) for p in panels), "some sub-panel starts closed"
+    for panel in panels:
+        props = [e for e in draw_body(panel) if e.kind in ("prop", "prop_search") and not e.in_list]
+        unsplit = [e.name for e in props if not e.split]
+        assert not unsplit, f"{panel.__name__} draws {unsplit} without use_property_split"
 
 
 @pytest.mark.parametrize("prefix", ["KODAWARI_PT_swim", "KODAWARI_PT_hair", "KODAWARI_PT_gait"])
@@ -125,6 +97,76 @@ def test_panels_hide_for_objects_they_do_not_serve(empty_scene, prefix):
     camera = bpy.data.objects.new("Camera", bpy.data.cameras.new("Camera"))
     empty_scene.collection.objects.link(camera)
     bpy.context.view_layer.objects.active = camera
-    for name in dir(bpy.types):
-        if name.startswith(prefix):
-            assert not getattr(bpy.types, name).poll(bpy.context)
+    for panel in kodawari_classes(prefix):
+        assert not panel.poll(bpy.context), f"{panel.__name__} shows on a camera"
+
+
+def test_feature_panels_hide_on_objects_without_the_feature(empty_scene):
+    """A plain armature (a horse without hair, a hair rig without gait, a plain mesh) shows
+    no settings panel of a feature it does not use, only that feature's one Add entry."""
+    hair_rig = _hair_rig(empty_scene)
+    bpy.context.view_layer.objects.active = hair_rig
+    assert not [p.__name__ for p in _settings_panels("KODAWARI_PT_gait") if p.poll(bpy.context)]
+    assert bpy.types.KODAWARI_PT_gait_add.poll(bpy.context)
+    add = draw_body(bpy.types.KODAWARI_PT_gait_add)
+    assert [e.name for e in add if e.kind == "operator"] == ["kodawari.gait_setup"]
+
+    gait_horse = _gait_horse(empty_scene)
+    bpy.context.view_layer.objects.active = gait_horse
+    assert not [p.__name__ for p in _settings_panels("KODAWARI_PT_hair") if p.poll(bpy.context)]
+    assert [e.name for e in draw_body(bpy.types.KODAWARI_PT_hair_add) if e.kind == "operator"] == [
+        "kodawari.rod_add"]
+
+    mesh = make_fish("tuna")
+    bpy.context.view_layer.objects.active = mesh
+    assert not [p.__name__ for p in _settings_panels("KODAWARI_PT_swim") if p.poll(bpy.context)]
+    assert [e.name for e in draw_body(bpy.types.KODAWARI_PT_swim_add) if e.kind == "operator"] == [
+        "kodawari.swim_add"]
+
+
+def test_sidebar_tab_shows_the_active_creature(empty_scene):
+    obj = make_fish("tuna")
+    add_swim(obj)
+    panel = bpy.types.KODAWARI_PT_sidebar
+    assert panel.bl_space_type == "VIEW_3D" and panel.bl_region_type == "UI" and panel.bl_category == "Kodawari"
+    assert panel.poll(bpy.context)
+    entries = draw_body(panel)
+    assert "prop frequency" in entries and "operator kodawari.swim_bake" in entries
+    _gait_horse(empty_scene)
+    entries = draw_body(panel)
+    assert "prop speed" in entries and "operator kodawari.gait_bake" in entries
+    assert "operator kodawari.rod_add" in entries, "the horse can be given hair from the tab"
+
+
+LABEL_ROOM = 12  # columns of text the label side of a split row shows at the default Properties width
+
+
+def _columns(text):
+    import unicodedata
+
+    return sum(2 if unicodedata.east_asian_width(c) in "WF" else 1 for c in text)
+
+
+@pytest.mark.parametrize("prefix", ["KODAWARI_PT_swim", "KODAWARI_PT_hair", "KODAWARI_PT_gait"])
+def test_split_labels_fit_the_default_width(empty_scene, prefix):
+    """Labels left of a setting are not cut off ("Referenc…"), in English or Japanese.
+    The room was measured on screenshots of the real window (blend_samples/ui_screenshots.py):
+    "Acceleration" and "Swing Height" fit, "Head Amplitude" and "Reference Bone" were cut."""
+    from kodawari.translations import ja
+
+    {"KODAWARI_PT_swim": lambda: add_swim(make_fish("tuna"), fins=("fin_pectoral",)),
+     "KODAWARI_PT_hair": lambda: _hair_rig(empty_scene),
+     "KODAWARI_PT_gait": lambda: _gait_horse(empty_scene)}[prefix]()
+    too_long = []
+    for panel in [p for p in _settings_panels(prefix) if p.poll(bpy.context)]:
+        for entry in draw_body(panel):
+            if entry.kind not in ("prop", "prop_search") or not entry.split or entry.in_list:
+                continue
+            rna = entry.kwargs["data"].bl_rna.properties[entry.name]
+            if rna.type == "BOOLEAN":
+                continue  # a checkbox's text is on the wide side
+            label = entry.kwargs.get("text", rna.name)
+            for text in (label, ja.STRINGS.get(label, "")):
+                if _columns(text) > LABEL_ROOM:
+                    too_long.append((panel.__name__, text))
+    assert not too_long, f"labels cut off at the default width: {too_long}"

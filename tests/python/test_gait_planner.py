@@ -43,7 +43,8 @@ def test_steady_gait_matches_the_table(gait, speed):
     seg = measure(out, rig, fps, slice(2 * fps, None))
     assert len(seg) == 1 and seg[0]["gait"] == metrics.GAITS[gait]
     row = kn.gait_horse_table()["gaits"][gait]
-    duty, swing = row[0], row[3]
+    leg_length = max(leg["heads"][0][2] - leg["tail"][2] for leg in rig["legs"][2:])
+    duty, swing = kn.gait_duty_factor(kn.gait_horse_table(), gait, speed, leg_length), row[3]
     phases = kn.gait_leg_phases(kn.gait_horse_table(), gait)
     for leg, name in enumerate(metrics.LEGS):
         got = seg[0]["legs"][name]
@@ -154,7 +155,8 @@ def test_transition_completes_within_two_strides():
         out, rig = bake(np.full(n, speed), mode, fps)
         table = kn.gait_horse_table()
         row = table["gaits"][new]
-        period = row[3] / (1 - row[0])
+        leg_length = max(leg["heads"][0][2] - leg["tail"][2] for leg in rig["legs"][2:])
+        period = row[3] / (1 - kn.gait_duty_factor(table, new, speed, leg_length))
         target = kn.gait_leg_phases(table, new)
         # Phases of each lift-off relative to LH's latest lift-off, stride by stride.
         c = out["contacts"]
@@ -237,6 +239,34 @@ def test_speed_step_recentres_every_stance():
         after = downs[downs > step + 0.3 * fps]
         strides = np.linalg.norm(np.diff(out["feet_planned"][after, leg], axis=0), axis=1)
         assert strides[:3] == pytest.approx(v1 * swing / (1 - duty), abs=0.01)
+
+
+def test_gallop_stride_lengthens_at_low_gallop_speed():
+    # Thoroughbreds: stride 4.5 m at 9 m/s, 7.1 m at 17 m/s (duty factor ~0.2 only at the
+    # top). A fixed duty factor of 0.2 gave 3.7 m at 9 m/s.
+    fps = 240
+    for speed, lo, hi in ((9.0, 4.1, 4.7), (17.0, 6.8, 7.3)):
+        out, rig = bake(np.full(5 * fps, speed), GALLOP, fps)
+        seg = measure(out, rig, fps, slice(2 * fps, None))[0]
+        for name in metrics.LEGS:
+            assert lo <= seg["legs"][name]["stride"] <= hi, (speed, name, seg["legs"][name]["stride"])
+
+
+def test_table_scales_with_leg_length_by_froude_number():
+    horse = kn.gait_horse_table()
+    fox = kn.gait_horse_table(kn.GAIT_HORSE_LEG_LENGTH / 4)  # a leg a quarter as long
+    for g in range(5):
+        assert fox["gaits"][g][8] == pytest.approx(horse["gaits"][g][8] / 2)  # speeds x sqrt(1/4)
+        assert fox["gaits"][g][3] == pytest.approx(horse["gaits"][g][3] / 2)  # times x sqrt(1/4)
+        assert fox["gaits"][g][4] == pytest.approx(horse["gaits"][g][4] / 4)  # heights x 1/4
+        assert fox["gaits"][g][9] == pytest.approx(horse["gaits"][g][9])  # Froude numbers stay
+    assert kn.gait_table_speed_max(fox, -1, 0.35) == pytest.approx(9.0, rel=0.01)
+
+
+def test_names_come_from_the_core():
+    assert kn.GAIT_NAMES == ("WALK", "TROT", "CANTER", "GALLOP", "GALLOP_ROTARY")
+    assert kn.LEG_NAMES == ("LF", "RF", "LH", "RH")
+    assert metrics.GAITS == kn.GAIT_NAMES and metrics.LEGS == kn.LEG_NAMES
 
 
 def test_bad_arrays_raise_clear_errors():

@@ -1,4 +1,4 @@
-"""Fish swim: any fish mesh swims by bending along a control axis (SEEDS §1, issue 3).
+"""Fish swim: any fish mesh swims by bending along a control axis (docs/algorithms.md §1, §2).
 
 Object.kodawari_swim holds the settings; runtime.py evaluates on frame changes
 into the "Kodawari Swim" shape key; ops.py adds, tunes, bakes and removes.
@@ -6,7 +6,7 @@ into the "Kodawari Swim" shape key; ops.py adds, tunes, bakes and removes.
 
 import bpy
 
-from . import ops, panel, props, runtime
+from . import apply, ops, panel, props, runtime, visibility
 
 CLASSES = (
     props.KodawariSwimFin,
@@ -18,8 +18,9 @@ CLASSES = (
     ops.KODAWARI_OT_swim_fin_find,
     ops.KODAWARI_OT_swim_flip_head,
     ops.KODAWARI_OT_swim_bake,
-    panel.KODAWARI_UL_swim_fins,
-    panel.KODAWARI_PT_swim,
+    ops.KODAWARI_OT_swim_free_bake,
+    *apply.CLASSES,
+    *panel.CLASSES,
 )
 
 PROPERTIES = (
@@ -33,4 +34,5 @@ PROPERTIES = (
 HANDLERS = (
     ("frame_change_post", runtime.on_frame_change),
     ("load_post", runtime.on_load),
+    *visibility.HANDLERS,
 )

@@ -12,11 +12,13 @@ import struct
 import bpy
 import numpy as np
 
-from .. import fcurves
+from .. import cache_paths, editable, fcurves
+from ..bake_job import BakeError, BakeJob
 from . import runtime
 
 CACHE_MODIFIER = "Kodawari Swim Cache"
 BAKED_KEY_PREFIX = "Kodawari Swim "
+TRAVEL_GROUP = "Kodawari Swim"  # the F-curve group of the baked travel
 
 
 def pc2_header(points, start, rate, samples):
@@ -34,51 +36,56 @@ def read_pc2(path):
 
 
 def default_cache_path(obj):
-    name = bpy.path.clean_name(obj.name) + "_swim.pc2"
-    if bpy.data.filepath:
-        return "//" + name
-    return os.path.join(bpy.app.tempdir or os.path.dirname(os.path.abspath(__file__)), name)
+    """`//blendcache_<file>/<object>_swim.pc2`; BakeError when the file is unsaved."""
+    return cache_paths.default_path(obj, "swim", ".pc2")
 
 
-class Baker:
-    """Bakes frame by frame so a modal operator can show progress and cancel."""
+class SwimBakeJob(BakeJob):
+    """Bakes frame by frame into a PC2 file (played by a Mesh Cache modifier) or shape keys."""
 
-    def __init__(self, obj, scene, frame_start, frame_end, target, filepath):
+    title = "Fish swim bake"
+
+    def __init__(self, obj, scene, frame_start, frame_end, target, filepath=""):
         self.obj = obj
         self.scene = scene
         self.frames = list(range(frame_start, frame_end + 1))
         self.target = target
         self.filepath = filepath
-        self.absolute_path = bpy.path.abspath(filepath) if filepath else ""
+        self.absolute_path = ""
         self.original_frame = (scene.frame_current, scene.frame_subframe)
         self.index = 0
         self.handle = None
         self.keys = []  # SHAPE_KEYS: positions per frame, made into keys at the end
         self.travel = []  # speed mode: the object's travel per frame
-        self.follow = (
-            runtime.path.follow_path(obj) if obj.kodawari_swim.speed_mode != "NONE" else None
-        )
+        self.follow = None
+        self.stepped = False
+        self.was_enabled = None  # set by prepare: the live switch to put back
 
-    @property
-    def done(self):
-        return self.index >= len(self.frames)
-
-    @property
-    def progress(self):
-        return self.index / max(1, len(self.frames))
-
-    def start(self):
+    def prepare(self):
+        obj = self.obj
+        why = editable.why_not(obj, "bake its swim")
+        if why:
+            raise BakeError(why)
+        if obj.kodawari_swim.baked != "NONE":
+            raise BakeError(f"'{obj.name}' is already baked: Free Bake first to bake again")
+        # Every binding input checked before a frame is baked (a deleted fin group fails here).
+        runtime.get_rig(obj)
+        if obj.kodawari_swim.speed_mode != "NONE":
+            self.follow = runtime.path.follow_path(obj)
         if self.target == "MESH_CACHE":
-            folder = os.path.dirname(self.absolute_path)
-            if folder:
-                os.makedirs(folder, exist_ok=True)
-            # Stays open across the modal bake's steps; closed by finish() or cancel().
-            self.handle = open(self.absolute_path + ".part", "wb")  # noqa: SIM115
-            count = len(self.obj.data.vertices)
+            self.filepath = self.filepath or default_cache_path(obj)
+            self.absolute_path = cache_paths.check_target(obj, self.filepath)
+            self.handle = cache_paths.open_partial(self.absolute_path)
+            count = len(obj.data.vertices)
             self.handle.write(pc2_header(count, self.frames[0], 1.0, len(self.frames)))
+        # The bake evaluates the fish itself: the live frame handler leaves it alone meanwhile.
+        self.was_enabled = obj.kodawari_swim.enabled
+        with runtime.batch(obj):
+            obj.kodawari_swim.enabled = False
 
     def step(self):
         frame = self.frames[self.index]
+        self.stepped = True
         self.scene.frame_set(frame)
         positions = runtime.evaluate(self.obj, self.scene, frame)
         if self.handle is not None:
@@ -91,38 +98,43 @@ class Baker:
                 self.follow.offset_factor if self.follow else tuple(self.obj.delta_location)
             )
         self.index += 1
+        return self.index / len(self.frames)
 
     def _restore_frame(self):
         self.scene.frame_set(self.original_frame[0], subframe=self.original_frame[1])
 
     def cancel(self):
         """Leave everything as it was: no file, no key, no modifier, the same frame."""
-        if self.handle is not None:
-            self.handle.close()
+        if self.absolute_path:
+            cache_paths.discard_partial(self.handle, self.absolute_path)
             self.handle = None
-            os.remove(self.absolute_path + ".part")
         self.keys = []
         settings = self.obj.kodawari_swim
-        if settings.speed_mode != "NONE" and self.follow is None:
-            self.obj.delta_location = settings.rest_delta_location
-        self._restore_frame()
+        if self.was_enabled is not None:
+            with runtime.batch(self.obj):
+                settings.enabled = self.was_enabled
+            self.was_enabled = None
+        if self.stepped:
+            if settings.speed_mode != "NONE" and self.follow is None:
+                self.obj.delta_location = settings.rest_delta_location
+            self._restore_frame()
 
     def finish(self):
         obj = self.obj
         settings = obj.kodawari_swim
         block = runtime.swim_key_block(obj)
         if self.target == "MESH_CACHE":
+            # The file first: a failing rename leaves the object untouched (cancel cleans up).
             self.handle.close()
             self.handle = None
             os.replace(self.absolute_path + ".part", self.absolute_path)
+            self.absolute_path = ""  # the finished file is kept from here on
             modifier = obj.modifiers.get(CACHE_MODIFIER) or obj.modifiers.new(
                 CACHE_MODIFIER, "MESH_CACHE"
             )
             modifier.cache_format = "PC2"
             # Relative to the .blend when it is saved, so the pair can move together.
-            modifier.filepath = (
-                bpy.path.relpath(self.absolute_path) if bpy.data.filepath else self.absolute_path
-            )
+            modifier.filepath = cache_paths.stored_path(bpy.path.abspath(self.filepath))
             modifier.time_mode = "FRAME"
             modifier.play_mode = "SCENE"
             modifier.frame_start = float(self.frames[0])
@@ -159,9 +171,52 @@ class Baker:
                 path,
                 np.array(self.frames, dtype=np.float32),
                 values,
-                group="Kodawari Swim",
+                group=TRAVEL_GROUP,
             )
         if block is not None:
             block.value = 0.0
         settings.baked = self.target
+        with runtime.batch(obj):
+            settings.enabled = self.was_enabled
+        self.was_enabled = None
         self._restore_frame()
+        where = f"to {self.filepath}" if self.target == "MESH_CACHE" else "to shape keys"
+        return f"Baked {len(self.frames)} frames of '{obj.name}' {where}; live evaluation is off"
+
+
+def free_bake(obj):
+    """Drop the bake and go live again; the setup (fins, preset, bend, timing) stays.
+    The PC2 file is deleted only when it lies in this file's own cache folder."""
+    settings = obj.kodawari_swim
+    modifier = obj.modifiers.get(CACHE_MODIFIER)
+    if modifier is not None:
+        path = modifier.filepath
+        obj.modifiers.remove(modifier)
+        if cache_paths.is_own_cache(path) and not cache_paths.caches_in_use().get(
+            os.path.normpath(bpy.path.abspath(path))
+        ):
+            try:
+                os.remove(bpy.path.abspath(path))
+            except OSError:
+                pass  # already gone, or not ours to delete: the modifier is what mattered
+    keys = obj.data.shape_keys
+    if keys is not None:
+        baked = [b for b in keys.key_blocks if b.name.startswith(BAKED_KEY_PREFIX)]
+        anim = keys.animation_data
+        for block in baked:
+            if anim is not None and anim.action is not None:
+                curve = fcurves.find_fcurve(anim.action, keys, f'key_blocks["{block.name}"].value')
+                if curve is not None:
+                    fcurves.remove_fcurve(anim.action, keys, curve)
+            obj.shape_key_remove(block)
+    anim = obj.animation_data
+    if anim is not None and anim.action is not None:
+        for curve in list(fcurves.action_fcurves(anim.action, obj)):
+            if curve.group is not None and curve.group.name == TRAVEL_GROUP:
+                fcurves.remove_fcurve(anim.action, obj, curve)
+    obj.delta_location = settings.rest_delta_location
+    block = runtime.swim_key_block(obj)
+    if block is not None:
+        block.value = 1.0
+    settings.cache_path = ""
+    settings.baked = "NONE"

@@ -1,7 +1,7 @@
 """Automatic fin finder: the parts of the mesh standing out of the body's cross-section.
 
 The work is the core's (kodawari_native.swim_fin_axis_coordinates, swim_find_fins;
-docs/algorithms.md "Fish: finding fins"): each vertex is placed in the body's
+docs/algorithms.md §2.8): each vertex is placed in the body's
 cross-section along the swim axis, each cross-section's outline gets a core
 ellipse fitted with the fins left out, and vertices well outside it that hang
 together along mesh edges are fins, named by where they sit. No per-vertex

@@ -1,10 +1,12 @@
-"""Fin set-up (SEEDS §1 "Fins"): a small control axis per fin, bound once.
+"""Fin set-up (docs/algorithms.md §2.4-§2.5): each fin part bound once in the core.
 
-A fin's vertices come from a vertex group. Its axis runs root → tip with the
-first three of five control points clustered at the root (they stay fixed, so
-the fin never tears from the body); an undulating fin's axis runs along its base
-instead. Each fin vertex blends from the body's motion at the root to the fin's
-own motion further out, so root vertices move exactly with the body.
+A fin's vertices come from a vertex group. How far each stands from the body is
+its path across the fin from where it meets the body (fin_reach, native); the
+fin's motion swings every vertex about its own root point by that reach, faded
+in from 0 at the root (so root vertices move exactly with the body and the fin
+never tears from it) to the full motion over the first root_blend of the fin
+(an undulating fin: over its whole height). The core (kodawari_native.FinPart)
+turns the motion with the body's rotation at the fin root every frame.
 """
 
 import numpy as np

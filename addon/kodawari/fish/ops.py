@@ -3,14 +3,14 @@
 # bl_options sets are Blender's class-attribute convention, never mutated.
 # ruff: noqa: RUF012
 
-import os
 import types
 
 import bpy
 import numpy as np
 from bpy.props import EnumProperty, FloatProperty, IntProperty, StringProperty
 
-from .. import bulk, fcurves, native
+from .. import bulk, cache_paths, editable, fcurves, native
+from ..bake_job import BakeError, BakeOperator, frame_range
 from . import bake, finder, midline, presets, runtime, validate
 from . import fins as fin_setup
 from . import rig as rig_module
@@ -38,9 +38,11 @@ class KODAWARI_OT_swim_add(bpy.types.Operator):
         name="Head Axis",
         items=[("AUTO", "Auto", "Guess from the shape (reported)")] + list(HEAD_AXES),
         default="AUTO",
+        description="Which way the head points (Auto: guessed from the shape)",
     )
     preset: EnumProperty(
-        name="Preset", items=[(k, *presets.LABELS[k]) for k in presets.ORDER], default="CARANGIFORM"
+        name="Preset", items=[(k, *presets.LABELS[k]) for k in presets.ORDER], default="CARANGIFORM",
+        description="A kind of swimmer: sets the body wave and the fins' motions",
     )
     frequency: FloatProperty(
         name="Frequency", description="Tail beats per second (0: the preset's)", default=0.0
@@ -59,7 +61,11 @@ class KODAWARI_OT_swim_add(bpy.types.Operator):
         ):
             error = f"'{obj.name}' already swims: tune it in the Modifier tab, or remove it first"
         else:
-            error = validate.swim_target(obj) or validate.frequency(self.frequency)
+            error = (
+                editable.why_not(obj, "swim")
+                or validate.swim_target(obj)
+                or validate.frequency(self.frequency)
+            )
         if error:
             self.report({"ERROR"}, error)
             return {"CANCELLED"}
@@ -157,6 +163,10 @@ class KODAWARI_OT_swim_remove(bpy.types.Operator):
         ):
             self.report({"ERROR"}, f"'{obj.name}' has no Fish Swim to remove")
             return {"CANCELLED"}
+        error = editable.why_not(obj, "lose its swim")
+        if error:
+            self.report({"ERROR"}, error)
+            return {"CANCELLED"}
         with runtime.batch(obj):
             remove_swim(obj)
         self.report({"INFO"}, f"Fish Swim removed from '{obj.name}'; its mesh is as it was")
@@ -220,9 +230,9 @@ def add_fin(obj, group_name, kind, rebind=True):
 def _needs_swim(obj):
     if obj is None or obj.type != "MESH":
         return "Select the swimming mesh object first"
-    if not obj.kodawari_swim.enabled or runtime.swim_key_block(obj) is None:
+    if runtime.swim_key_block(obj) is None:  # hidden in the viewport (enabled off) still swims
         return f"'{obj.name}' does not swim yet: Add Fish Swim first"
-    return None
+    return editable.why_not(obj, "change its swim")
 
 
 class KODAWARI_OT_swim_fin_add(bpy.types.Operator):
@@ -233,7 +243,7 @@ class KODAWARI_OT_swim_fin_add(bpy.types.Operator):
     bl_options = {"REGISTER", "UNDO"}
 
     vertex_group: StringProperty(name="Vertex Group", description="The fin's vertices")
-    kind: EnumProperty(name="Kind", items=_fin_kind_items(), default="PECTORAL")
+    kind: EnumProperty(name="Kind", items=_fin_kind_items(), default="PECTORAL", description="Which fin this is")
 
     def invoke(self, context, event):
         obj = _active_mesh(context)
@@ -406,19 +416,13 @@ class KODAWARI_OT_swim_flip_head(bpy.types.Operator):
         return {"FINISHED"}
 
 
-class KODAWARI_OT_swim_bake(bpy.types.Operator):
+class KODAWARI_OT_swim_bake(BakeOperator, bpy.types.Operator):
     """Bake the swim to a PC2 point cache (Mesh Cache modifier) or to shape keys"""
 
     bl_idname = "kodawari.swim_bake"
     bl_label = "Bake Fish Swim"
     bl_options = {"REGISTER", "UNDO"}
 
-    frame_start: IntProperty(
-        name="Start", description="First frame (unset: the scene's start)", default=1
-    )
-    frame_end: IntProperty(
-        name="End", description="Last frame (unset: the scene's end)", default=250
-    )
     target: EnumProperty(
         name="Target",
         items=[
@@ -430,109 +434,46 @@ class KODAWARI_OT_swim_bake(bpy.types.Operator):
             ("SHAPE_KEYS", "Shape Keys", "One shape key per frame, keyed on at its frame"),
         ],
         default="MESH_CACHE",
+        description="Where the baked swim goes",
     )
     filepath: StringProperty(
-        name="File", description="PC2 file (empty: beside the .blend)", subtype="FILE_PATH"
+        name="File",
+        description="PC2 file (empty: in the folder blendcache_<file name> beside the .blend)",
+        subtype="FILE_PATH",
+        options=cache_paths.RELATIVE_PATH_OPTIONS,
     )
 
-    _baker = None
-    _timer = None
-
-    def _prepare(self, context):
-        # Unset frames mean the scene's range.
-        if not self.properties.is_property_set("frame_start"):
-            self.frame_start = context.scene.frame_start
-        if not self.properties.is_property_set("frame_end"):
-            self.frame_end = context.scene.frame_end
+    def make_job(self, context):
         obj = _active_mesh(context)
         error = _needs_swim(obj)
-        if error is None and obj.kodawari_swim.baked != "NONE":
-            error = f"'{obj.name}' is already baked: remove the swim to start again"
-        if error is None and self.frame_end < self.frame_start:
-            error = (
-                f"The end frame {self.frame_end} comes before the start frame {self.frame_start}"
-            )
-        if error is None and self.target == "MESH_CACHE":
-            path = self.filepath or bake.default_cache_path(obj)
-            folder = os.path.dirname(bpy.path.abspath(path)) or "."
-            if not os.path.isdir(folder) and not os.access(os.path.dirname(folder) or ".", os.W_OK):
-                error = f"Cannot write the cache into '{folder}'"
         if error:
-            self.report({"ERROR"}, error)
-            return None
-        path = (
-            (self.filepath or bake.default_cache_path(obj)) if self.target == "MESH_CACHE" else ""
-        )
-        baker = bake.Baker(obj, context.scene, self.frame_start, self.frame_end, self.target, path)
-        baker.start()
-        return baker
+            raise BakeError(error)
+        start, end = frame_range(self, context.scene)
+        return bake.SwimBakeJob(obj, context.scene, start, end, self.target, self.filepath)
+
+
+class KODAWARI_OT_swim_free_bake(bpy.types.Operator):
+    """Free the bake and swim live again; the setup (fins, preset, bend, timing) is kept"""
+
+    bl_idname = "kodawari.swim_free_bake"
+    bl_label = "Free Bake"
+    bl_options = {"REGISTER", "UNDO"}
 
     def execute(self, context):
-        baker = self._prepare(context)
-        if baker is None:
+        obj = _active_mesh(context)
+        if obj is None or obj.type != "MESH" or obj.kodawari_swim.baked == "NONE":
+            self.report({"ERROR"}, "Select a fish with a baked swim first")
             return {"CANCELLED"}
-        wm = context.window_manager
-        wm.progress_begin(0, len(baker.frames))
-        try:
-            while not baker.done:
-                baker.step()
-                wm.progress_update(baker.index)
-            baker.finish()
-        except Exception:
-            baker.cancel()
-            raise
-        finally:
-            wm.progress_end()
-        self.report({"INFO"}, self._done_message(baker))
+        error = editable.why_not(obj, "free its bake")
+        if error:
+            self.report({"ERROR"}, error)
+            return {"CANCELLED"}
+        with runtime.batch(obj):
+            bake.free_bake(obj)
+        runtime.forget(obj)
+        if runtime.is_live(obj):
+            runtime.evaluate(obj, context.scene)
+        self.report(
+            {"INFO"}, f"Freed the bake of '{obj.name}': it swims live again with the same setup"
+        )
         return {"FINISHED"}
-
-    def invoke(self, context, event):
-        if bpy.app.background:
-            return self.execute(context)
-        self._baker = self._prepare(context)
-        if self._baker is None:
-            return {"CANCELLED"}
-        wm = context.window_manager
-        wm.progress_begin(0, len(self._baker.frames))
-        self._timer = wm.event_timer_add(0.001, window=context.window)
-        wm.modal_handler_add(self)
-        return {"RUNNING_MODAL"}
-
-    def modal(self, context, event):
-        wm = context.window_manager
-        if event.type == "ESC":
-            self._end(context)
-            self._baker.cancel()
-            self.report({"WARNING"}, "Bake cancelled: nothing was changed")
-            return {"CANCELLED"}
-        if event.type == "TIMER":
-            try:
-                self._baker.step()
-            except Exception as exc:  # noqa: BLE001 - any failure mid-bake is undone and reported
-                self._end(context)
-                self._baker.cancel()
-                self.report({"ERROR"}, f"Bake failed and was undone: {exc}")
-                return {"CANCELLED"}
-            wm.progress_update(self._baker.index)
-            if context.area:
-                context.area.header_text_set(
-                    f"Baking fish swim {self._baker.index}/{len(self._baker.frames)} (Esc cancels)"
-                )
-            if self._baker.done:
-                self._end(context)
-                self._baker.finish()
-                self.report({"INFO"}, self._done_message(self._baker))
-                return {"FINISHED"}
-        return {"RUNNING_MODAL"}
-
-    def _end(self, context):
-        wm = context.window_manager
-        wm.event_timer_remove(self._timer)
-        wm.progress_end()
-        if context.area:
-            context.area.header_text_set(None)
-
-    @staticmethod
-    def _done_message(baker):
-        where = f"to {baker.filepath}" if baker.target == "MESH_CACHE" else "to shape keys"
-        return f"Baked {len(baker.frames)} frames of '{baker.obj.name}' {where}; live evaluation is off"

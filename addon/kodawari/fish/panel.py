@@ -1,8 +1,19 @@
-"""The Fish Swim panel in the Modifier Properties tab (our deformer's "modifier")."""
+"""The Fish Swim panel in the Modifier tab, laid out like a modifier: eye and camera
+toggles in the header, where it runs in the stack, the everyday settings on top,
+the rest in sub-panels (body wave and travel start closed)."""
+
+# bl_options sets are Blender's class-attribute convention, never mutated.
+# ruff: noqa: RUF012
 
 import bpy
+from bpy.app.translations import pgettext_iface as iface_
 
-from . import overlay, runtime
+from .. import in_use, problems
+from . import overlay, visibility
+
+MODIFIER_ICONS = {"ARMATURE": "MOD_ARMATURE", "SUBSURF": "MOD_SUBSURF", "MIRROR": "MOD_MIRROR",
+                  "MESH_CACHE": "MOD_MESHDEFORM", "SOLIDIFY": "MOD_SOLIDIFY", "BEVEL": "MOD_BEVEL",
+                  "NODES": "GEOMETRY_NODES"}
 
 
 class KODAWARI_UL_swim_fins(bpy.types.UIList):
@@ -11,16 +22,48 @@ class KODAWARI_UL_swim_fins(bpy.types.UIList):
     def draw_item(self, context, layout, data, item, icon, active_data, active_propname, index):
         row = layout.row(align=True)
         row.prop(item, "enabled", text="")
-        row.label(text=item.vertex_group or "(no group)")
-        row.label(text=f"{item.kind.title()} · {item.motion.replace('_', '-').title()}")
+        split = row.split(factor=0.6)
+        split.label(text=item.vertex_group or iface_("(no group)"), translate=False)
+        split.prop(item, "kind", text="", emboss=False)
 
 
-class KODAWARI_PT_swim(bpy.types.Panel):
-    bl_idname = "KODAWARI_PT_swim"
-    bl_label = "Fish Swim (Kodawari)"
+def _split(layout):
+    layout.use_property_split = True
+    layout.use_property_decorate = True
+    return layout
+
+
+def _live(context):
+    obj = context.object
+    return in_use.swim(obj) and obj.kodawari_swim.baked == "NONE"
+
+
+def wrap(text, width=30):
+    """Lines of at most `width` characters, so a long note is not cut off at the default width."""
+    lines, line = [], ""
+    for word in text.split():
+        if line and len(line) + 1 + len(word) > width:
+            lines.append(line)
+            line = word
+        else:
+            line = f"{line} {word}".strip()
+    return [*lines, line] if line else lines
+
+
+class _SwimPanel:
     bl_space_type = "PROPERTIES"
     bl_region_type = "WINDOW"
     bl_context = "modifier"
+
+    @classmethod
+    def poll(cls, context):
+        return _live(context)
+
+
+class KODAWARI_PT_swim(_SwimPanel, bpy.types.Panel):
+    bl_idname = "KODAWARI_PT_swim"
+    bl_label = "Fish Swim"
+    bl_order = 0  # above the modifier stack: the swim runs before every modifier
 
     # The axis overlay lives as long as the panel is registered.
     @classmethod
@@ -33,70 +76,114 @@ class KODAWARI_PT_swim(bpy.types.Panel):
 
     @classmethod
     def poll(cls, context):
-        return context.object is not None and context.object.type == "MESH"
+        return in_use.swim(context.object)
 
     def draw_header(self, context):
         settings = context.object.kodawari_swim
-        if runtime.swim_key_block(context.object) is not None:
-            self.layout.prop(settings, "enabled", text="")
+        if settings.baked == "NONE":
+            visibility.draw_toggles(self.layout, settings)
+
+    def draw(self, context):
+        layout = _split(self.layout)
+        obj = context.object
+        settings = obj.kodawari_swim
+        if settings.baked != "NONE":
+            col = layout.column()
+            target = settings.bl_rna.properties["baked"].enum_items[settings.baked].name
+            col.label(text=iface_("Baked to {}").format(iface_(target)), icon="CHECKMARK", translate=False)
+            if settings.baked == "MESH_CACHE":
+                col.label(text=settings.cache_path, icon="FILE_CACHE", translate=False)
+            col = layout.column(align=True)  # stacked: side by side, "Remove Fish Swim" is cut off
+            col.operator("kodawari.swim_free_bake", icon="TRASH")
+            col.operator("kodawari.swim_remove", icon="X")
+            return
+        problem = problems.message(obj, "swim")
+        if problem:
+            box = layout.box()
+            box.alert = True
+            box.label(text=iface_("Not swimming: {}").format(problem), icon="ERROR", translate=False)
+        layout.label(text="Runs before all modifiers", icon="SORT_ASC")
+        col = layout.column()
+        col.prop(settings, "preset")
+        row = col.row(align=True)
+        row.prop(settings, "head_axis")
+        row.operator("kodawari.swim_flip_head", text="", icon="ARROW_LEFTRIGHT")
+        if settings.head_guess:
+            note = layout.column(align=True)
+            for index, line in enumerate(wrap(settings.head_guess)):
+                note.label(text=line, icon="INFO" if index == 0 else "BLANK1", translate=False)
+        col = layout.column()
+        col.prop(settings, "frequency")
+        col.prop(settings, "amplitude", slider=True)
+        col.prop(settings, "wavelength")
+        col.prop(settings, "bend")
+        layout.separator()
+        col = layout.column(align=True)
+        col.operator("kodawari.swim_bake", text="Bake to Mesh Cache", icon="FILE_CACHE").target = "MESH_CACHE"
+        col.operator("kodawari.swim_bake", text="Bake to Shape Keys", icon="SHAPEKEY_DATA").target = "SHAPE_KEYS"
+        row = layout.row(align=True)
+        row.operator("kodawari.swim_apply", text="Apply", icon="CHECKMARK")
+        row.operator("kodawari.swim_remove", text="Remove", icon="X")
+
+
+class KODAWARI_PT_swim_body(_SwimPanel, bpy.types.Panel):
+    bl_label = "Body Wave"
+    bl_parent_id = "KODAWARI_PT_swim"
+    bl_options = {"DEFAULT_CLOSED"}
+
+    def draw(self, context):
+        layout = _split(self.layout)
+        settings = context.object.kodawari_swim
+        col = layout.column()
+        col.prop(settings, "amplitude_head", slider=True)
+        col.prop(settings, "envelope_start", slider=True)
+        col.prop(settings, "envelope_power")
+        col.prop(settings, "phase_offset")
+        col = layout.column()
+        col.prop(settings, "preserve_length")
+        col.prop(settings, "control_points")
+        col.prop(settings, "show_axis")
+
+
+class KODAWARI_PT_swim_travel(_SwimPanel, bpy.types.Panel):
+    bl_label = "Travel"
+    bl_parent_id = "KODAWARI_PT_swim"
+    bl_options = {"DEFAULT_CLOSED"}
+
+    def draw(self, context):
+        layout = _split(self.layout)
+        obj = context.object
+        settings = obj.kodawari_swim
+        col = layout.column()
+        col.prop(settings, "speed_mode")
+        if settings.speed_mode == "STROUHAL":
+            col.prop(settings, "strouhal")
+        if settings.speed_mode != "NONE" and any(c.type == "FOLLOW_PATH" for c in obj.constraints):
+            col.prop(settings, "path_start", slider=True)
+
+
+class KODAWARI_PT_swim_fins(_SwimPanel, bpy.types.Panel):
+    bl_label = "Fins"
+    bl_parent_id = "KODAWARI_PT_swim"
 
     def draw(self, context):
         layout = self.layout
         obj = context.object
         settings = obj.kodawari_swim
-        if runtime.swim_key_block(obj) is None and settings.baked == "NONE":
-            layout.operator("kodawari.swim_add", icon="MOD_WAVE")
-            return
-        if settings.baked != "NONE":
-            layout.label(
-                text=f"Baked to {settings.baked.replace('_', ' ').title()}"
-                + (f": {settings.cache_path}" if settings.baked == "MESH_CACHE" else ""),
-                icon="CHECKMARK",
-            )
-            layout.operator("kodawari.swim_remove", icon="X")
-            return
-        layout.prop(settings, "preset")
-        row = layout.row(align=True)
-        row.prop(settings, "head_axis")
-        row.operator("kodawari.swim_flip_head", text="", icon="ARROW_LEFTRIGHT")
-        if settings.head_guess:
-            layout.label(text=settings.head_guess, icon="INFO")
-        col = layout.column(align=True)
-        col.prop(settings, "frequency")
-        col.prop(settings, "wavelength")
-        col.prop(settings, "amplitude")
-        col.prop(settings, "amplitude_head")
-        col.prop(settings, "envelope_start")
-        col.prop(settings, "envelope_power")
-        col.prop(settings, "phase_offset")
-        layout.prop(settings, "bend", expand=True)
         row = layout.row()
-        row.prop(settings, "preserve_length")
-        row.prop(settings, "control_points")
-        layout.prop(settings, "show_axis")
-        row = layout.row(align=True)
-        row.prop(settings, "speed_mode")
-        if settings.speed_mode == "STROUHAL":
-            row.prop(settings, "strouhal")
-        if settings.speed_mode != "NONE" and any(c.type == "FOLLOW_PATH" for c in obj.constraints):
-            layout.prop(settings, "path_start")
-
-        layout.label(text="Fins")
-        row = layout.row()
-        row.template_list(
-            "KODAWARI_UL_swim_fins", "", settings, "fins", settings, "fin_index", rows=3
-        )
+        row.template_list("KODAWARI_UL_swim_fins", "", settings, "fins", settings, "fin_index", rows=3)
         col = row.column(align=True)
         col.operator("kodawari.swim_fin_add", text="", icon="ADD")
         col.operator("kodawari.swim_fin_remove", text="", icon="REMOVE")
+        col.separator()
         col.operator("kodawari.swim_fin_find", text="", icon="VIEWZOOM")
         if 0 <= settings.fin_index < len(settings.fins):
             fin = settings.fins[settings.fin_index]
-            box = layout.box()
-            box.prop_search(fin, "vertex_group", obj, "vertex_groups")
-            box.prop(fin, "kind")
-            box.prop(fin, "motion")
-            col = box.column(align=True)
+            col = _split(layout.column())
+            col.prop_search(fin, "vertex_group", obj, "vertex_groups")
+            col.prop(fin, "kind")
+            col.prop(fin, "motion")
+            col = _split(layout.column())
             col.prop(fin, "amplitude")
             col.prop(fin, "frequency_ratio")
             col.prop(fin, "phase_lag")
@@ -104,12 +191,40 @@ class KODAWARI_PT_swim(bpy.types.Panel):
                 col.prop(fin, "feathering")
             if fin.motion == "UNDULATE":
                 col.prop(fin, "wavelength")
-            col.prop(fin, "root_blend")
+            col.prop(fin, "root_blend", slider=True)
 
-        layout.separator()
-        row = layout.row(align=True)
-        op = row.operator("kodawari.swim_bake", text="Bake to Mesh Cache", icon="FILE_CACHE")
-        op.target = "MESH_CACHE"
-        op = row.operator("kodawari.swim_bake", text="Bake to Shape Keys", icon="SHAPEKEY_DATA")
-        op.target = "SHAPE_KEYS"
-        layout.operator("kodawari.swim_remove", icon="X")
+
+class KODAWARI_PT_swim_order(_SwimPanel, bpy.types.Panel):
+    """Where the swim sits among the object's modifiers (it always runs first)."""
+
+    bl_label = "Evaluation Order"
+    bl_parent_id = "KODAWARI_PT_swim"
+    bl_options = {"DEFAULT_CLOSED"}
+
+    def draw(self, context):
+        col = self.layout.column(align=True)
+        col.label(text=iface_("1. Fish Swim (shape key)"), icon="MOD_WAVE", translate=False)
+        for index, modifier in enumerate(context.object.modifiers, start=2):
+            icon = MODIFIER_ICONS.get(modifier.type, "MODIFIER")
+            col.label(text=f"{index}. {modifier.name}", icon=icon, translate=False)
+
+
+class KODAWARI_PT_swim_add(bpy.types.Panel):
+    """On a mesh that does not swim: one "Add Fish Swim" button where the modifiers are."""
+
+    bl_label = "Fish Swim"
+    bl_space_type = "PROPERTIES"
+    bl_region_type = "WINDOW"
+    bl_context = "modifier"
+    bl_options = {"HIDE_HEADER"}
+
+    @classmethod
+    def poll(cls, context):
+        return in_use.can_swim(context.object) and not in_use.swim(context.object)
+
+    def draw(self, context):
+        self.layout.operator("kodawari.swim_add", icon="MOD_WAVE")
+
+
+CLASSES = (KODAWARI_UL_swim_fins, KODAWARI_PT_swim_add, KODAWARI_PT_swim, KODAWARI_PT_swim_body, KODAWARI_PT_swim_travel,
+           KODAWARI_PT_swim_fins, KODAWARI_PT_swim_order)

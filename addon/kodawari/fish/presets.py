@@ -1,8 +1,8 @@
-"""Swimming modes of the fish document (SEEDS §1) with numbers from the literature.
+"""Swimming modes of the fish document (docs/algorithms.md §2.7) with numbers from the literature.
 
 Body values are fractions of body length L; fin amplitudes are radians for FLAP,
 UP_DOWN and TWIST and, for UNDULATE, the sideways excursion as a fraction of the fin's height.
-Amplitudes are CRUISE values (docs/algorithms.md, "Fish: presets"): a tail peak of
+Amplitudes are CRUISE values (docs/algorithms.md §2.7): a tail peak of
 0.06 L is a peak-to-peak of 0.12 L, inside the 0.1-0.13 L of cruising fish (Webb 1975;
 Videler 1993, Fish Swimming); Bainbridge's (1958) maximum, about L/5 peak-to-peak
 (peak 0.1 L), stays reachable with the Amplitude setting.

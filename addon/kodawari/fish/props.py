@@ -15,6 +15,7 @@ from bpy.props import (
     StringProperty,
 )
 
+from .. import cache_paths
 from . import presets
 
 HEAD_AXES = (
@@ -67,6 +68,7 @@ class KodawariSwimFin(bpy.types.PropertyGroup):
         items=[(k, k.title(), f"{k.title()} fin") for k in presets.FIN_KINDS],
         default="PECTORAL",
         update=_rebind,
+        description="Which fin this is; it sets the default motion and where the fin's root is",
     )
     motion: EnumProperty(
         name="Motion",
@@ -82,18 +84,21 @@ class KodawariSwimFin(bpy.types.PropertyGroup):
         ],
         default="FLAP",
         update=_rebind,
+        description="How the fin moves",
     )
-    enabled: BoolProperty(name="Enabled", default=True, update=_refresh)
+    enabled: BoolProperty(name="Enabled", default=True, update=_refresh,
+                          description="Move this fin (off: it follows the body only)")
     amplitude: FloatProperty(
         name="Amplitude",
-        description="Peak angle (radians) for Flap, Up-Down and Twist; sideways excursion as a fraction of the fin's height for Undulate",
+        description="How far the fin swings to each side. Undulate: the sideways reach as a share of the fin's height (1 rad = 1 height)",
+        subtype="ANGLE",
         default=0.3,
         min=0.0,
         soft_max=1.5,
         update=_refresh,
     )
     frequency_ratio: FloatProperty(
-        name="Frequency Ratio",
+        name="Beat Ratio",
         description="Fin beats per tail beat (1: same frequency as the body)",
         default=1.0,
         min=0.0,
@@ -102,7 +107,7 @@ class KodawariSwimFin(bpy.types.PropertyGroup):
     )
     phase_lag: FloatProperty(
         name="Phase Lag",
-        description="Lag behind the body wave",
+        description="How far the fin's beat lags behind the body's",
         subtype="ANGLE",
         default=0.0,
         update=_refresh,
@@ -118,7 +123,7 @@ class KodawariSwimFin(bpy.types.PropertyGroup):
     )
     wavelength: FloatProperty(
         name="Wavelength",
-        description="Undulate: wave length in fin-base lengths",
+        description="Undulate: length of the wave along the fin, in fin-base lengths",
         default=0.8,
         min=0.05,
         soft_max=4.0,
@@ -126,7 +131,8 @@ class KodawariSwimFin(bpy.types.PropertyGroup):
     )
     root_blend: FloatProperty(
         name="Root Blend",
-        description="Fraction of the fin, from its root, over which it blends from the body's motion to its own",
+        description="Share of the fin, from its root, that blends from the body's motion into its own",
+        subtype="FACTOR",
         default=0.35,
         min=0.01,
         max=1.0,
@@ -138,9 +144,15 @@ class KodawariSwimSettings(bpy.types.PropertyGroup):
     """The fish swim deformer of one mesh object."""
 
     enabled: BoolProperty(
-        name="Enabled",
-        description="Evaluate the swim on frame changes",
+        name="Show in Viewport",
+        description="Show the swim in the viewport (off: the fish keeps its rest shape there)",
         default=False,
+        update=_refresh,
+    )
+    show_render: BoolProperty(
+        name="Show in Render",
+        description="Use the swim when rendering (off: the fish renders in its rest shape)",
+        default=True,
         update=_refresh,
     )
     preset: EnumProperty(
@@ -148,6 +160,7 @@ class KodawariSwimSettings(bpy.types.PropertyGroup):
         items=[(k, *presets.LABELS[k]) for k in presets.ORDER],
         default="CARANGIFORM",
         update=_preset_changed,
+        description="A kind of swimmer: sets the body wave and the fins' motions (you can tune them after)",
     )
     head_axis: EnumProperty(
         name="Head Axis",
@@ -157,8 +170,8 @@ class KodawariSwimSettings(bpy.types.PropertyGroup):
         description="Object axis the head points along",
     )
     control_points: IntProperty(
-        name="Control Points",
-        description="Control points of the body axis",
+        name="Axis Points",
+        description="How many points bend the body: more follow a long body's wave more closely",
         default=8,
         min=4,
         max=32,
@@ -166,7 +179,7 @@ class KodawariSwimSettings(bpy.types.PropertyGroup):
     )
     frequency: FloatProperty(
         name="Frequency",
-        description="Tail beats per second (Hz)",
+        description="Tail beats per second",
         default=2.0,
         min=0.0,
         soft_max=10.0,
@@ -174,7 +187,7 @@ class KodawariSwimSettings(bpy.types.PropertyGroup):
     )
     wavelength: FloatProperty(
         name="Wavelength",
-        description="Body wave length in body lengths",
+        description="Length of the body wave, in body lengths (short: eel-like, long: tuna-like)",
         default=1.0,
         min=0.05,
         soft_max=4.0,
@@ -182,7 +195,9 @@ class KodawariSwimSettings(bpy.types.PropertyGroup):
     )
     amplitude: FloatProperty(
         name="Amplitude",
-        description="Tail-tip peak amplitude as a fraction of body length",
+        description="How far the tail tip swings to each side, as a share of the body length",
+        subtype="FACTOR",
+        precision=3,
         default=0.06,
         min=0.0,
         soft_max=0.3,
@@ -190,8 +205,10 @@ class KodawariSwimSettings(bpy.types.PropertyGroup):
         update=_refresh,
     )
     amplitude_head: FloatProperty(
-        name="Head Amplitude",
-        description="Snout peak amplitude as a fraction of body length",
+        name="Snout Swing",
+        description="How far the snout swings to each side, as a share of the body length",
+        subtype="FACTOR",
+        precision=3,
         default=0.006,
         min=0.0,
         soft_max=0.3,
@@ -199,8 +216,8 @@ class KodawariSwimSettings(bpy.types.PropertyGroup):
         update=_refresh,
     )
     envelope_start: FloatProperty(
-        name="Envelope Start",
-        description="Where, from the snout (fraction of the body), the amplitude starts to grow",
+        name="Swing Starts",
+        description="Where along the body, from the snout, the swing starts to grow toward the tail",
         default=0.45,
         min=0.0,
         max=0.99,
@@ -208,8 +225,8 @@ class KodawariSwimSettings(bpy.types.PropertyGroup):
         update=_refresh,
     )
     envelope_power: FloatProperty(
-        name="Envelope Power",
-        description="How the amplitude grows toward the tail (1 linear, 2 quadratic...)",
+        name="Swing Ramp",
+        description="How the swing grows toward the tail: 1 evenly, higher keeps it near the tail",
         default=1.6,
         min=0.1,
         soft_max=5.0,
@@ -219,9 +236,10 @@ class KodawariSwimSettings(bpy.types.PropertyGroup):
         name="Bend",
         items=[
             ("LATERAL", "Lateral", "Side to side (most fish)"),
-            ("DORSOVENTRAL", "Dorsoventral", "Up and down (marine mammals)"),
+            ("DORSOVENTRAL", "Up and Down", "Up and down (whales, dolphins)"),
         ],
         default="LATERAL",
+        description="Which way the body bends",
         update=_refresh,
     )
     preserve_length: BoolProperty(
@@ -231,8 +249,8 @@ class KodawariSwimSettings(bpy.types.PropertyGroup):
         update=_refresh,
     )
     phase_offset: FloatProperty(
-        name="Phase Offset",
-        description="Shift of the wave",
+        name="Time Shift",
+        description="Shifts the wave in time, so fish in a school do not swim in step",
         subtype="ANGLE",
         default=0.0,
         update=_refresh,
@@ -243,27 +261,28 @@ class KodawariSwimSettings(bpy.types.PropertyGroup):
             ("NONE", "None", "Swim on the spot"),
             (
                 "BAINBRIDGE",
-                "Bainbridge",
+                "From Tail Beat",
                 (
-                    "V = L(3f - 4)/4 (Bainbridge 1958), fitted above about 5 Hz: elsewhere the "
-                    "speed is held to Strouhal 0.2-0.4. Fin swimmers: half a body length per fin beat"
+                    "Faster with a faster tail beat, as measured on real fish (Bainbridge 1958: V = L(3f - 4)/4, fitted above about 5 Hz; elsewhere held to Strouhal 0.2-0.4). "
+                    "Fin swimmers: half a body length per fin beat"
                 ),
             ),
             (
                 "STROUHAL",
-                "Strouhal",
+                "From Tail Swing",
                 (
-                    "U = f A / St, A the tail's peak-to-peak excursion. Fin swimmers (no body "
+                    "Faster with a wider, faster tail swing (Strouhal number). Fin swimmers (no body "
                     "wave): half a body length per fin beat"
                 ),
             ),
         ],
         default="NONE",
+        description="Whether and how the fish moves forward as it swims",
         update=_speed_changed,
     )
     strouhal: FloatProperty(
         name="Strouhal",
-        description="Strouhal number St = f A / U (0.2-0.4 in nature)",
+        description="Lower swims faster for the same tail beat (real fish: 0.2 to 0.4)",
         default=0.3,
         min=0.05,
         max=2.0,
@@ -278,18 +297,19 @@ class KodawariSwimSettings(bpy.types.PropertyGroup):
         subtype="FACTOR",
         update=_refresh,
     )
-    fins: CollectionProperty(type=KodawariSwimFin)
-    fin_index: IntProperty(name="Active Fin", default=0)
+    fins: CollectionProperty(type=KodawariSwimFin, name="Fins", description="The fins that move on their own")
+    fin_index: IntProperty(name="Active Fin", default=0, description="The fin shown below the list")
     show_axis: BoolProperty(
         name="Show Axis", description="Draw the control axis in the viewport", default=True
     )
 
     # Book-keeping (not shown): what swim_add found and what it must restore.
     head_guess: StringProperty(
-        name="Head Guess", description="What Add Fish Swim guessed for the head axis"
+        name="Head Guess", description="Which way Add Fish Swim guessed the head points, and why"
     )
     rest_delta_location: FloatVectorProperty(
-        name="Rest Delta Location", size=3, subtype="TRANSLATION"
+        name="Rest Delta Location", size=3, subtype="TRANSLATION",
+        description="Where the fish was before it swam off (restored when the swim is removed)"
     )
     baked: EnumProperty(
         name="Baked",
@@ -299,5 +319,9 @@ class KodawariSwimSettings(bpy.types.PropertyGroup):
             ("SHAPE_KEYS", "Shape Keys", "Baked to shape keys"),
         ],
         default="NONE",
+        description="Whether the swim is live or baked, and to what",
     )
-    cache_path: StringProperty(name="Cache Path", subtype="FILE_PATH")
+    cache_path: StringProperty(
+        name="Cache Path", subtype="FILE_PATH", options=cache_paths.RELATIVE_PATH_OPTIONS,
+        description="The baked point cache file",
+    )

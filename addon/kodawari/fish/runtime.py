@@ -13,8 +13,8 @@ import bpy
 import mathutils
 from bpy.app.handlers import persistent
 
-from .. import bulk
-from . import path, timing
+from .. import bulk, problems
+from . import path, timing, visibility
 from . import rig as rig_module
 
 SHAPE_KEY = rig_module.SHAPE_KEY
@@ -86,7 +86,7 @@ def is_live(obj):
         obj is not None
         and obj.type == "MESH"
         and obj.mode != "EDIT"
-        and obj.kodawari_swim.enabled
+        and visibility.visible(obj)
         and obj.kodawari_swim.baked == "NONE"
         and swim_key_block(obj) is not None
     )
@@ -132,13 +132,16 @@ def evaluate(obj, scene, frame=None):
 
 def refresh(obj):
     """Re-evaluate after a setting changed (no-op while batched or not live)."""
+    visibility.sync(obj)  # the viewport/render toggles may have changed
     if _key(obj) in _batch_depth or not is_live(obj):
         return
     scene = bpy.context.scene
     try:
         evaluate(obj, scene)
-    except ValueError as exc:  # e.g. a fin group emptied by the user: say so, keep the last frame
-        print(f"Kodawari Swim: {obj.name}: {exc}")
+    except Exception as exc:  # noqa: BLE001 - e.g. a fin group emptied: say so, keep the last frame
+        problems.report(obj, "swim", exc)
+    else:
+        problems.clear(obj, "swim")
 
 
 def rebind(obj, known_weights=None):
@@ -159,7 +162,11 @@ def separate_linked_duplicates(scene):
             continue
         owner = owners.setdefault(obj.data.as_pointer(), obj)
         if owner is not obj:
-            obj.data = obj.data.copy()
+            try:
+                obj.data = obj.data.copy()
+            except (RuntimeError, AttributeError) as exc:  # e.g. a write-protected object
+                problems.report(obj, "swim", exc)
+                continue
             forget(obj)
             print(
                 f"Kodawari Swim: '{obj.name}' shared its mesh with '{owner.name}' (a linked "
@@ -175,8 +182,10 @@ def on_frame_change(scene, depsgraph=None):
             continue
         try:
             evaluate(obj, scene)
-        except ValueError as exc:
-            print(f"Kodawari Swim: {obj.name}: {exc}")
+        except Exception as exc:  # noqa: BLE001 - one broken fish never stops the others
+            problems.report(obj, "swim", exc)
+        else:
+            problems.clear(obj, "swim")
 
 
 @persistent
@@ -191,5 +200,5 @@ def on_load(_dummy=None, *_args):
         if obj.type == "MESH" and is_live(obj):
             try:
                 evaluate(obj, scene)
-            except ValueError as exc:
-                print(f"Kodawari Swim: {obj.name}: {exc}")
+            except Exception as exc:  # noqa: BLE001 - one broken fish never stops the others
+                problems.report(obj, "swim", exc)

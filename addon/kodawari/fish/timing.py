@@ -1,6 +1,6 @@
 """Wave phase and distance travelled at a frame, accumulated from the scene start.
 
-The literature notes (docs/algorithms.md, "Fish: phase") ask for φ += ω·dt, never
+The literature notes (docs/algorithms.md §2.2) ask for φ += ω·dt, never
 ω·t: with a keyframed frequency, ω·t would make the whole wave jump when the
 frequency changes. The phase at frame F integrates the (possibly animated)
 frequency from the scene's start frame to F, one sample per frame, with the

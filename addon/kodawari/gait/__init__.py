@@ -1,5 +1,5 @@
 """Quadruped gaits: walk, trot, canter and gallop from a speed curve, legs solved by
-CCD IK with joint limits and stiffness, baked to an Action (seed section 3)."""
+CCD IK with joint limits and stiffness, baked to an Action (docs/algorithms.md §4)."""
 
 import bpy
 
@@ -13,7 +13,7 @@ CLASSES = (
     ops.KODAWARI_OT_gait_setup,
     ops.KODAWARI_OT_gait_bake,
     ops.KODAWARI_OT_gait_report,
-    panel.KODAWARI_PT_gait,
+    *panel.CLASSES,
 )
 
 PROPERTIES = (

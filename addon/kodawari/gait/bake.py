@@ -6,6 +6,7 @@ import bpy
 import numpy as np
 
 from .. import fcurves, native
+from ..bake_job import BakeJob
 from . import rig as rigmod
 from . import runtime
 from .props import GAIT_NAMES, LEG_NAMES
@@ -37,51 +38,94 @@ def _path_points(context, obj, path_obj):
         evaluated.to_mesh_clear()
     if n < 2:
         raise ValueError(f"the path curve '{path_obj.name}' has no length")
-    to_arm = obj.matrix_world.inverted() @ path_obj.matrix_world
-    rotation = rigmod.mat3(to_arm)
-    offset = np.array([float(to_arm[i][3]) for i in range(3)])
+    # World points less the armature's placement: the gait frame (rig.gait_frame).
+    m = path_obj.matrix_world
+    rotation = rigmod.mat3(m)
+    offset = np.array([float(m[i][3]) for i in range(3)]) - rigmod.gait_origin(obj)
     pts = co.reshape(-1, 3) @ rotation.T + offset
     return np.ascontiguousarray(pts)
 
 
-def _heightfield(context, obj, ground, feet, margin=1.0, max_cells=256):
-    """Ground heights (armature space) on a grid over the run, by ray casts straight
-    down onto the ground mesh. Raises ValueError when rays miss."""
+def _run_region(rig, speed, fps, path, margin):
+    """(lo, hi) in the gait frame's x, y: where the animal can go, from the keyed speeds
+    (the acceleration limit only shortens the run) along its heading or path."""
+    head = rig["body_head"][:2]
+    distance = float(np.sum(speed) / fps) + 1.0
+    if path is not None:
+        points = np.vstack([path[:, :2], head[None, :]])
+        d = path[-1, :2] - path[-2, :2]
+        points = np.vstack([points, path[-1, :2] + d / max(np.linalg.norm(d), 1e-9) * distance])
+    else:
+        points = np.array([head, head + rig["forward"][:2] * distance])
+    feet = np.array([leg["tail"][:2] for leg in rig["legs"]])
+    reach = float(np.max(np.linalg.norm(feet - head, axis=1))) + margin
+    return points.min(axis=0) - reach, points.max(axis=0) + reach
+
+
+def _heightfield(context, obj, ground, rig, lo, hi, max_cells=256):
+    """Ground heights (gait frame) on a grid over the run, by ray casts straight down
+    onto the ground mesh. Raises ValueError when rays miss."""
     from mathutils import Vector
     from mathutils.bvhtree import BVHTree
 
     depsgraph = context.evaluated_depsgraph_get()
     tree = BVHTree.FromObject(ground.evaluated_get(depsgraph), depsgraph)
-    lo = feet[:, :, :2].reshape(-1, 2).min(axis=0) - margin
-    hi = feet[:, :, :2].reshape(-1, 2).max(axis=0) + margin
     cell = max(float((hi - lo).max()) / (max_cells - 1), 0.05)
     nx = int(np.ceil((hi[0] - lo[0]) / cell)) + 1
     ny = int(np.ceil((hi[1] - lo[1]) / cell)) + 1
-    arm_to_ground = ground.matrix_world.inverted() @ obj.matrix_world
-    ground_to_arm = obj.matrix_world.inverted() @ ground.matrix_world
-    top = float(feet[:, :, 2].max()) + 1000.0
-    direction = (arm_to_ground.to_3x3() @ Vector((0.0, 0.0, -1.0))).normalized()
+    origin = Vector(rigmod.gait_origin(obj))
+    to_ground = ground.matrix_world.inverted()
+    top = float(max(leg["heads"][0][2] for leg in rig["legs"])) + 1000.0
+    direction = (to_ground.to_3x3() @ Vector((0.0, 0.0, -1.0))).normalized()
     heights = np.empty(nx * ny, dtype=np.float64)
     misses = 0
     # One ray per grid cell (not per frame): a set-up cost, like reading the rig.
     for j in range(ny):
         y = lo[1] + j * cell
         for i in range(nx):
-            origin = arm_to_ground @ Vector((lo[0] + i * cell, y, top))
-            hit = tree.ray_cast(origin, direction)
+            hit = tree.ray_cast(to_ground @ (origin + Vector((lo[0] + i * cell, y, top))), direction)
             if hit[0] is None:
                 heights[j * nx + i] = np.nan
                 misses += 1
             else:
-                heights[j * nx + i] = (ground_to_arm @ hit[0]).z
+                heights[j * nx + i] = (ground.matrix_world @ hit[0]).z - origin.z
     if misses:
         raise ValueError(f"the ground '{ground.name}' does not lie under the whole run "
                          f"({misses} of {nx * ny} rays missed): move or enlarge it, or clear Ground")
     return {"x0": float(lo[0]), "y0": float(lo[1]), "cell": cell, "nx": nx, "ny": ny, "heights": heights}
 
 
-class GaitBakeJob:
-    """validate+solve in __init__ (raises ValueError), then begin/steps/finish or cancel."""
+def object_motion(rig, result):
+    """Root motion on the object: (delta location (F, 3), delta rotation quaternions
+    (F, 4) w-first) from the body motion the core solved about the leg roots' centre
+    (body_rest is the identity there). Blender composes the delta rotation before the
+    object's own (world = T(loc + dloc) R_delta R_own S), so the delta location is the
+    pivot's travel less the rotated pivot."""
+    q = result["body_rotation"] / np.linalg.norm(result["body_rotation"], axis=1, keepdims=True)
+    w, x, y, z = q.T
+    rot = np.stack([
+        np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)], axis=1),
+        np.stack([2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)], axis=1),
+        np.stack([2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)], axis=1)], axis=1)
+    pivot = rig["body_head"]
+    head = pivot[None, :] + result["body_location"]
+    return head - rot @ pivot, q
+
+
+def euler_xyz(q):
+    """Quaternions (F, 4) w-first to XYZ Euler angles (F, 3), unwrapped over time."""
+    w, x, y, z = q.T
+    ex = np.arctan2(2 * (w * x + y * z), 1 - 2 * (x * x + y * y))
+    ey = np.arcsin(np.clip(2 * (w * y - z * x), -1.0, 1.0))
+    ez = np.arctan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z))
+    return np.unwrap(np.stack([ex, ey, ez], axis=1), axis=0)
+
+
+class GaitBakeJob(BakeJob):
+    """validate+solve in __init__ (raises ValueError), then begin/steps/finish or cancel;
+    prepare/step are the BakeJob protocol (bake_job.py) over begin/steps."""
+
+    title = "Gait bake"
 
     def __init__(self, context, obj, frame_start, frame_end):
         if obj is None or obj.type != "ARMATURE":
@@ -95,6 +139,9 @@ class GaitBakeJob:
         self.frames = np.arange(frame_start, frame_end + 1, dtype=np.float64)
         self.fps = self.scene.render.fps / self.scene.render.fps_base
         self.rig, self.chains = rigmod.rig_dict(obj, settings)
+        if self.rig["on_object"] and obj.rotation_mode not in ("XYZ", "QUATERNION"):
+            raise ValueError(f"root motion on the object keys its delta rotation: set '{obj.name}' to the XYZ Euler "
+                             f"or Quaternion rotation mode (it is {obj.rotation_mode})")
         self.table = rigmod.table_dict(settings)
         why = kn.gait_validate_table(self.table)
         if why:
@@ -108,22 +155,22 @@ class GaitBakeJob:
             raise ValueError(f"speed is negative ({speed[speed < 0][0]:.2f} m/s at frame {f}): "
                              "key speeds of 0 or more")
         length = rigmod.leg_length(self.rig)
-        tops = {int(g): kn.gait_table_speed_max(self.table, int(g), length) for g in np.unique(mode)}
-        top = np.array([tops[int(g)] for g in mode]) if len(tops) > 1 else np.full(len(mode), tops[int(mode[0])])
-        too_fast = speed > top + 1e-6
-        if too_fast.any():
-            f = int(np.argmax(too_fast))
-            g = int(mode[f])
+        frame, top = kn.gait_check_speeds(self.table, np.ascontiguousarray(speed),
+                                          np.ascontiguousarray(mode, dtype=np.float64), length)
+        if frame >= 0:
+            g = int(mode[frame])
             what = "the gait table" if g < 0 else GAIT_NAMES[g]
-            raise ValueError(f"speed {speed[f]:.2f} m/s at frame {int(self.frames[f])} is past the range of {what} "
-                             f"(top {top[f]:.2f} m/s): lower it or raise the table's top speed")
+            raise ValueError(f"speed {speed[frame]:.2f} m/s at frame {int(self.frames[frame])} is past the range of "
+                             f"{what} (top {top:.2f} m/s): lower it or raise the table's top speed")
         path = _path_points(context, obj, settings.path) if settings.path is not None else None
-        args = (self.rig, self.table, np.ascontiguousarray(speed), np.ascontiguousarray(mode, dtype=np.float64),
-                float(self.fps), float(settings.acceleration), int(settings.ccd_iterations))
-        result = kn.gait_bake(*args, path=path)
+        ground = None
         if settings.ground is not None:
-            ground = _heightfield(context, obj, settings.ground, result["feet_planned"])
-            result = kn.gait_bake(*args, path=path, ground=ground)
+            lo, hi = _run_region(self.rig, speed, self.fps, path, margin=1.0)
+            ground = _heightfield(context, obj, settings.ground, self.rig, lo, hi)
+        result = kn.gait_bake(self.rig, self.table, np.ascontiguousarray(speed),
+                              np.ascontiguousarray(mode, dtype=np.float64), float(self.fps),
+                              float(settings.acceleration), int(settings.ccd_iterations), path=path, ground=ground)
+        if ground is not None:
             planted = result["contacts"] > 0.5
             miss = np.where(planted, result["ik_error"], 0.0)
             if miss.max() > 0.02:
@@ -141,6 +188,8 @@ class GaitBakeJob:
         self._old_action = anim.action if anim is not None else None
         self._old_slot = fcurves.current_slot_identifier(obj)
         self._old_modes = {pb.name: pb.rotation_mode for pb in obj.pose.bones}
+        self._old_deltas = (tuple(obj.delta_location), tuple(obj.delta_rotation_euler),
+                            tuple(obj.delta_rotation_quaternion))
         self._old_props = {k: obj[k] for k in CONTACT_PROPS + (GAIT_PROP,) if k in obj.keys()}
         # A new Action (the old one stays untouched until finish, so Esc can put it
         # back); the curves this bake does not own (the speed keys, other bones) are
@@ -159,10 +208,13 @@ class GaitBakeJob:
 
     def _owned_paths(self):
         bones = [n for leg in LEG_NAMES for n in self.chains[leg]]
-        body = self.obj.kodawari_gait.body_bone
-        paths = {f'pose.bones["{n}"].rotation_quaternion' for n in bones + [body]}
+        paths = {f'pose.bones["{n}"].rotation_quaternion' for n in bones}
         paths.update(f'pose.bones["{n}"].rotation_euler' for n in bones)
-        paths.add(f'pose.bones["{body}"].location')
+        if self.rig["on_object"]:
+            paths.update(("delta_location", "delta_rotation_euler", "delta_rotation_quaternion"))
+        else:
+            body = self.obj.kodawari_gait.body_bone
+            paths.update((f'pose.bones["{body}"].location', f'pose.bones["{body}"].rotation_quaternion'))
         paths.update(f'["{p}"]' for p in CONTACT_PROPS + (GAIT_PROP,))
         return paths
 
@@ -195,10 +247,22 @@ class GaitBakeJob:
                                      axis[2] * np.sin(half)], axis=1)
                     fcurves.write_channels(action, obj, f'pose.bones["{name}"].rotation_quaternion', frames,
                                            quat, group=name)
+            elif kind == "body" and self.rig["on_object"]:
+                # Root motion on the object, in its delta transforms (its own location,
+                # rotation and scale stay the user's placement).
+                location, quat = object_motion(self.rig, r)
+                fcurves.write_channels(action, obj, "delta_location", frames, location, group="Object Transforms")
+                if obj.rotation_mode == "QUATERNION":
+                    fcurves.write_channels(action, obj, "delta_rotation_quaternion", frames, quat,
+                                           group="Object Transforms")
+                else:
+                    fcurves.write_channels(action, obj, "delta_rotation_euler", frames, euler_xyz(quat),
+                                           group="Object Transforms")
             elif kind == "body":
                 obj.pose.bones[name].rotation_mode = "QUATERNION"
+                # The core solved in world metres: a bone's location is in armature units.
                 fcurves.write_channels(action, obj, f'pose.bones["{name}"].location', frames,
-                                       r["body_location"], group=name)
+                                       r["body_location"] / self.rig["scale"], group=name)
                 fcurves.write_channels(action, obj, f'pose.bones["{name}"].rotation_quaternion', frames,
                                        r["body_rotation"], group=name)
             else:
@@ -219,6 +283,7 @@ class GaitBakeJob:
             self.action.name = name
         runtime.remember(self.obj, self)
         self.obj.update_tag()
+        return f"Baked {len(self.frames)} frames of gait on '{self.obj.name}'"
 
     def cancel(self):
         """Put back the action, slot, rotation modes and custom properties."""
@@ -232,12 +297,21 @@ class GaitBakeJob:
         for name, mode in self._old_modes.items():
             if name in obj.pose.bones:
                 obj.pose.bones[name].rotation_mode = mode
+        obj.delta_location, obj.delta_rotation_euler, obj.delta_rotation_quaternion = self._old_deltas
         for key in CONTACT_PROPS + (GAIT_PROP,):
             if key in self._old_props:
                 obj[key] = self._old_props[key]
             elif key in obj.keys():
                 del obj[key]
         self._started = False
+
+    # --- the BakeJob protocol ---------------------------------------------------------
+    def prepare(self):
+        self.begin()
+        self._pending = self.steps()
+
+    def step(self):
+        return next(self._pending, 1.0)
 
     def run(self):
         self.begin()

@@ -1,58 +1,187 @@
-"""The gait panel in the armature's Object properties."""
+"""The Kodawari Gait panel (Object properties of a set-up armature), in Blender's layout:
+split labels with keyframe decorators, the everyday settings on top, and the rig, the
+gait table and the legs in sub-panels that start closed."""
+
+# bl_options sets are Blender's class-attribute convention, never mutated.
+# ruff: noqa: RUF012
 
 import bpy
 
+from .. import in_use
+from .props import GAIT_ITEMS, LEG_NAMES
 
-class KODAWARI_PT_gait(bpy.types.Panel):
-    bl_label = "Kodawari Gait"
+GAIT_LABELS = {identifier: label for identifier, label, _ in GAIT_ITEMS}
+LEG_LABELS = {"LF": "Left Fore Leg", "RF": "Right Fore Leg", "LH": "Left Hind Leg", "RH": "Right Hind Leg"}
+
+
+def _split(layout):
+    layout.use_property_split = True
+    layout.use_property_decorate = True
+    return layout
+
+
+class _GaitPanel:
     bl_space_type = "PROPERTIES"
     bl_region_type = "WINDOW"
     bl_context = "object"
 
     @classmethod
     def poll(cls, context):
-        return context.active_object is not None and context.active_object.type == "ARMATURE"
+        return in_use.gait(context.object)
+
+
+class KODAWARI_PT_gait(_GaitPanel, bpy.types.Panel):
+    bl_label = "Kodawari Gait"
 
     def draw(self, context):
-        layout = self.layout
-        settings = context.active_object.kodawari_gait
-        layout.operator("kodawari.gait_setup")
+        layout = _split(self.layout)
+        settings = context.object.kodawari_gait
         col = layout.column()
         col.prop(settings, "speed")
         col.prop(settings, "gait")
         col.prop(settings, "acceleration")
-        col.prop_search(settings, "body_bone", context.active_object.data, "bones")
-        col.prop(settings, "ccd_iterations")
+        row = layout.row(align=True)
+        row.operator("kodawari.gait_bake", icon="REC")
+        row.operator("kodawari.gait_report", icon="GRAPH")
+
+
+class KODAWARI_PT_gait_rig(_GaitPanel, bpy.types.Panel):
+    bl_label = "Rig and Ground"
+    bl_parent_id = "KODAWARI_PT_gait"
+    bl_options = {"DEFAULT_CLOSED"}
+
+    def draw(self, context):
+        layout = _split(self.layout)
+        obj = context.object
+        settings = obj.kodawari_gait
+        col = layout.column()
+        col.prop(settings, "root_motion")
+        col.prop_search(settings, "body_bone", obj.data, "bones")
         col.prop(settings, "ground")
         col.prop(settings, "path")
-        row = layout.row(align=True)
-        row.operator("kodawari.gait_bake")
-        row.operator("kodawari.gait_report")
-        box = layout.box()
-        box.label(text="Gait table")
-        row = box.row()
-        row.prop(settings, "use_froude")
-        row.prop(settings, "hysteresis")
-        row.prop(settings, "reach")
-        for entry in settings.table:
-            sub = box.column(align=True)
-            sub.label(text=entry.name)
-            r = sub.row(align=True)
-            r.prop(entry, "duty_factor", text="Duty")
-            r.prop(entry, "phase_fore_hind", text="D1")
-            r.prop(entry, "phase_left_right", text="D2")
-            r.prop(entry, "swing_time", text="Swing")
-            r = sub.row(align=True)
-            r.prop(entry, "swing_height", text="Lift")
-            r.prop(entry, "bob", text="Bob")
-            r.prop(entry, "speed_max" if not settings.use_froude else "froude_max", text="Top")
-            r.prop(entry, "use_in_auto", text="Auto")
-        for leg in settings.legs:
-            box = layout.box()
-            box.label(text=f"Leg {leg.name}")
-            for bone in leg.bones:
-                r = box.row(align=True)
-                r.label(text=bone.name)
-                r.prop(bone, "limit_min")
-                r.prop(bone, "limit_max")
-                r.prop(bone, "stiffness")
+        col.prop(settings, "ccd_iterations")
+        layout.operator("kodawari.gait_setup", text="Find Legs Again", icon="FILE_REFRESH")
+
+
+class KODAWARI_PT_gait_table(_GaitPanel, bpy.types.Panel):
+    bl_label = "Gait Table"
+    bl_parent_id = "KODAWARI_PT_gait"
+    bl_options = {"DEFAULT_CLOSED"}
+
+    def draw(self, context):
+        layout = _split(self.layout)
+        settings = context.object.kodawari_gait
+        col = layout.column()
+        col.prop(settings, "use_froude")
+        col.prop(settings, "hysteresis")
+        col.prop(settings, "reach", slider=True)
+
+
+def _entry(settings, name):
+    for entry in settings.table:
+        if entry.name == name:
+            return entry
+    return None
+
+
+def _gait_row_panel(name):
+    """One closed sub-panel per gait of the table (Walk, Trot, ...)."""
+
+    class Row(_GaitPanel, bpy.types.Panel):
+        bl_label = GAIT_LABELS[name]
+        bl_parent_id = "KODAWARI_PT_gait_table"
+        bl_options = {"DEFAULT_CLOSED"}
+
+        @classmethod
+        def poll(cls, context):
+            return in_use.gait(context.object) and _entry(context.object.kodawari_gait, name) is not None
+
+        def draw_header(self, context):
+            self.layout.prop(_entry(context.object.kodawari_gait, name), "use_in_auto", text="")
+
+        def draw(self, context):
+            layout = _split(self.layout)
+            settings = context.object.kodawari_gait
+            entry = _entry(settings, name)
+            col = layout.column()
+            col.prop(entry, "duty_factor", slider=True)
+            col.prop(entry, "duty_factor_top", slider=True)
+            col.prop(entry, "phase_fore_hind", slider=True)
+            col.prop(entry, "phase_left_right", slider=True)
+            col = layout.column()
+            col.prop(entry, "swing_time")
+            col.prop(entry, "swing_height")
+            col.prop(entry, "swing_peak", slider=True)
+            col = layout.column()
+            col.prop(entry, "bob")
+            col.prop(entry, "bobs_per_cycle")
+            col.prop(entry, "froude_max" if settings.use_froude else "speed_max")
+
+    Row.__name__ = Row.bl_idname = f"KODAWARI_PT_gait_table_{name.lower()}"
+    return Row
+
+
+class KODAWARI_PT_gait_legs(_GaitPanel, bpy.types.Panel):
+    bl_label = "Legs"
+    bl_parent_id = "KODAWARI_PT_gait"
+    bl_options = {"DEFAULT_CLOSED"}
+
+    def draw(self, context):
+        self.layout.label(text="Joint ranges from the rest pose; positive swings the tip backward")
+
+
+def _leg(settings, name):
+    for leg in settings.legs:
+        if leg.name == name:
+            return leg
+    return None
+
+
+def _leg_panel(name):
+    """One closed sub-panel per leg: each bone's hinge range and stiffness."""
+
+    class Leg(_GaitPanel, bpy.types.Panel):
+        bl_label = LEG_LABELS[name]
+        bl_parent_id = "KODAWARI_PT_gait_legs"
+        bl_options = {"DEFAULT_CLOSED"}
+
+        @classmethod
+        def poll(cls, context):
+            return in_use.gait(context.object) and _leg(context.object.kodawari_gait, name) is not None
+
+        def draw(self, context):
+            layout = _split(self.layout)
+            for bone in _leg(context.object.kodawari_gait, name).bones:
+                col = layout.column(align=True)
+                col.label(text=bone.name, icon="BONE_DATA", translate=False)
+                col.prop(bone, "limit_min")
+                col.prop(bone, "limit_max")
+                col.prop(bone, "stiffness", slider=True)
+
+    Leg.__name__ = Leg.bl_idname = f"KODAWARI_PT_gait_leg_{name.lower()}"
+    return Leg
+
+
+GAIT_ROW_PANELS = tuple(_gait_row_panel(identifier) for identifier, _, _ in GAIT_ITEMS[1:])
+LEG_PANELS = tuple(_leg_panel(name) for name in LEG_NAMES)
+
+# Parents before children.
+class KODAWARI_PT_gait_add(bpy.types.Panel):
+    """On an armature without a gait setup: one "Gait Setup" button."""
+
+    bl_label = "Kodawari Gait"
+    bl_space_type = "PROPERTIES"
+    bl_region_type = "WINDOW"
+    bl_context = "object"
+    bl_options = {"HIDE_HEADER"}
+
+    @classmethod
+    def poll(cls, context):
+        return in_use.can_rig(context.object) and not in_use.gait(context.object)
+
+    def draw(self, context):
+        self.layout.operator("kodawari.gait_setup", text="Set Up Gait (find legs)", icon="ANIM")
+
+
+CLASSES = (KODAWARI_PT_gait_add, KODAWARI_PT_gait, KODAWARI_PT_gait_rig, KODAWARI_PT_gait_table, *GAIT_ROW_PANELS,
+           KODAWARI_PT_gait_legs, *LEG_PANELS)

@@ -8,8 +8,8 @@ import os
 import bpy
 import numpy as np
 
-from .. import fcurves, native
-from . import metrics
+from .. import fcurves
+from . import metrics, report_svg
 from . import rig as rigmod
 from .bake import CONTACT_PROPS, GAIT_PROP
 from .font import draw_text
@@ -62,15 +62,57 @@ def read_baked(obj):
             q = np.stack(q, axis=1)
             # Hinge angle back from the quaternion (w, axis * sin(a/2)).
             angles.append(2 * np.arctan2(q[:, 1:] @ axes[name], q[:, 0]))
-    body = settings.body_bone
-    loc = np.stack([_curve(action, obj, f'pose.bones["{body}"].location', i)[1] for i in range(3)], axis=1)
-    rot = np.stack([_curve(action, obj, f'pose.bones["{body}"].rotation_quaternion', i)[1] for i in range(4)],
-                   axis=1)
-    return {"rig": rig, "chains": chains, "frames": frames, "angles": np.ascontiguousarray(np.stack(angles, axis=1)),
-            "body_location": np.ascontiguousarray(loc, dtype=np.float64),
-            "body_rotation": np.ascontiguousarray(rot, dtype=np.float64),
+    data = {"rig": rig, "chains": chains, "frames": frames,
+            "angles": np.ascontiguousarray(np.stack(angles, axis=1)),
             "contacts": np.stack([c[1] for c in contacts], axis=1).astype(np.float64),
             "gait": np.round(gait[1]).astype(int)}
+    if not rig["on_object"]:
+        body = settings.body_bone
+        loc = [_curve(action, obj, f'pose.bones["{body}"].location', i) for i in range(3)]
+        rot = [_curve(action, obj, f'pose.bones["{body}"].rotation_quaternion', i) for i in range(4)]
+        if any(c is None for c in loc + rot):
+            raise ValueError(f"the body bone '{body}' has no baked motion: bake the gait again")
+        data["body_location"] = np.ascontiguousarray(np.stack([c[1] for c in loc], axis=1), dtype=np.float64)
+        data["body_rotation"] = np.ascontiguousarray(np.stack([c[1] for c in rot], axis=1), dtype=np.float64)
+    return data
+
+
+def evaluated_legs(obj, scene, frames, chains):
+    """What Blender shows: feet (the last leg bone's tail) and leg roots (the first
+    bone's head), (F, 4, 3) in the gait frame (world metres less the armature's
+    placement), from the evaluated pose at each frame (scene.frame_set: other Actions,
+    NLA, drivers and constraints included). One frame change and one foreach_get per
+    frame; the current frame is put back."""
+    names = list(obj.pose.bones.keys())
+    feet_index = [names.index(chains[k][-1]) for k in LEG_NAMES]
+    root_index = [names.index(chains[k][0]) for k in LEG_NAMES]
+    origin = rigmod.gait_origin(obj)
+    n = len(names)
+    heads = np.empty(n * 3, dtype=np.float32)
+    tails = np.empty(n * 3, dtype=np.float32)
+    feet = np.empty((len(frames), 4, 3))
+    roots = np.empty((len(frames), 4, 3))
+    current = scene.frame_current, scene.frame_subframe
+    try:
+        for i, f in enumerate(frames):
+            scene.frame_set(int(f))
+            world = rigmod.mat4(obj.matrix_world)
+            obj.pose.bones.foreach_get("head", heads)
+            obj.pose.bones.foreach_get("tail", tails)
+            h = heads.reshape(-1, 3).astype(np.float64) @ world[:3, :3].T + world[:3, 3]
+            t = tails.reshape(-1, 3).astype(np.float64) @ world[:3, :3].T + world[:3, 3]
+            feet[i] = t[feet_index] - origin
+            roots[i] = h[root_index] - origin
+    finally:
+        scene.frame_set(current[0], subframe=current[1])
+    return feet, roots
+
+
+def headings_from_roots(roots):
+    """Unit forward of the body per frame: hind roots to fore roots, horizontal."""
+    h = (roots[:, 0] + roots[:, 1] - roots[:, 2] - roots[:, 3]) / 2
+    h[:, 2] = 0
+    return h / np.maximum(np.linalg.norm(h, axis=1, keepdims=True), 1e-12)
 
 
 def headings_of(rig, body_rotation):
@@ -88,16 +130,17 @@ def headings_of(rig, body_rotation):
     return h / np.linalg.norm(h, axis=1, keepdims=True)
 
 
-def measure_baked(obj, fps):
+def measure_baked(obj, fps, scene=None):
+    """The gait criteria of what Blender shows: contacts, gait and angles from the baked
+    Action, feet and roots from the evaluated pose (evaluated_legs)."""
     data = read_baked(obj)
-    kn = native.module()
-    feet, roots = kn.gait_forward_kinematics(data["rig"], data["angles"], data["body_location"],
-                                             data["body_rotation"])
+    scene = scene or bpy.context.scene
+    feet, roots = evaluated_legs(obj, scene, data["frames"], data["chains"])
     rig = data["rig"]
     limit_min = np.concatenate([leg["limit_min"] for leg in rig["legs"]])
     limit_max = np.concatenate([leg["limit_max"] for leg in rig["legs"]])
     reach = np.array([rig_reach(rig, k) for k in range(4)])
-    headings = headings_of(rig, data["body_rotation"])
+    headings = headings_from_roots(roots)
     segs = metrics.measure(feet, roots, headings, data["contacts"], data["gait"], data["angles"], limit_min,
                            limit_max, rigmod.neutral_offsets(rig), reach, fps)
     data.update(feet=feet, roots=roots, headings=headings, segments=segs, reach=reach)
@@ -201,5 +244,8 @@ def write_report(obj, filepath, fps):
               "segments": data["segments"]}
     with open(base + ".json", "w") as fh:
         json.dump(report, fh, indent=1)
-    save_png(draw_report(data, fps), base + ".png")
-    return base + ".png", base + ".json", data
+    save_png(draw_report(data, fps), base + ".png")  # a quick look in Blender's Image Editor
+    # The report to read and zoom: SVG with real text, axes, units and a legend.
+    data["neutral"] = rigmod.neutral_offsets(data["rig"])
+    report_svg.write(data, fps, base + ".svg", f"Gait report: {obj.name}")
+    return base + ".svg", base + ".json", data

@@ -1,5 +1,5 @@
 """View-dependent hair: joint chains that sway with physics and take the shapes the
-artist keyed per view, pose and speed (SEEDS.md section 2; Koyama & Igarashi 2013)."""
+artist keyed per view, pose and speed (docs/algorithms.md §3; Koyama & Igarashi 2013)."""
 
 import bpy
 
@@ -7,7 +7,11 @@ from . import handlers, ops, panel, props
 
 CLASSES = props.CLASSES + ops.CLASSES + panel.CLASSES
 PROPERTIES = (
-    (bpy.types.Object, "kodawari_hair", lambda: bpy.props.PointerProperty(type=props.KodawariHairSettings)),
+    (
+        bpy.types.Object,
+        "kodawari_hair",
+        lambda: bpy.props.PointerProperty(type=props.KodawariHairSettings),
+    ),
 )
 HANDLERS = (
     ("frame_change_post", handlers.on_frame_change),

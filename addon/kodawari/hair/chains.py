@@ -1,6 +1,7 @@
 """Joint chains of an armature: which bones make a rod and its static geometry."""
 
 import math
+import uuid
 
 import numpy as np
 
@@ -22,24 +23,63 @@ def chain_from(bone):
         if not children:
             return chain
         if len(children) > 1:
-            raise ChainError(f"Bone '{tip.name}' has {len(children)} children: a rod must be an unbranched chain "
-                             f"(select the bones after the branch instead)")
+            raise ChainError(
+                f"Bone '{tip.name}' has {len(children)} children: a rod must be an unbranched chain "
+                f"(select the bones after the branch instead)"
+            )
         chain.append(children[0])
 
 
+# Custom property on a rod's root pose bone holding the rod's uid: it follows the bone
+# through renames, so a renamed root is found again (and the setting renamed with it).
+ROD_ID_PROPERTY = "kodawari_rod"
+
+
+def tag_root(pose_bone, rod):
+    """Marks `pose_bone` as the root of `rod` (giving the rod a uid if it has none)."""
+    if not rod.uid:
+        rod.uid = uuid.uuid4().hex
+    pose_bone[ROD_ID_PROPERTY] = rod.uid
+
+
+def _renamed_root(armature_object, rod):
+    """The pose bone that carries the rod's uid, if the root was renamed."""
+    if not rod.uid:
+        return None
+    for pose_bone in armature_object.pose.bones:  # only when the name no longer resolves
+        if pose_bone.get(ROD_ID_PROPERTY) == rod.uid:
+            return pose_bone
+    return None
+
+
 def resolve_rod(armature_object, rod):
-    """(parent, reference, chain) data bones of a rod setting, or ChainError."""
+    """(parent, reference, chain) data bones of a rod setting, or ChainError. A root bone
+    renamed since the rod was made is followed, and the setting takes the new name."""
     bones = armature_object.data.bones
     root = bones.get(rod.root_bone)
     if root is None:
-        raise ChainError(f"Rod '{rod.root_bone}' has 0 joints: its root bone is missing from the armature")
+        renamed = _renamed_root(armature_object, rod)
+        if renamed is not None:
+            root = renamed.bone
+            try:
+                rod.root_bone = renamed.name
+            except (AttributeError, RuntimeError):  # a context that may not write IDs (drawing)
+                pass
+    if root is None:
+        raise ChainError(
+            f"Rod '{rod.root_bone}' has 0 joints: its root bone is missing from the armature"
+        )
     if root.parent is None:
-        raise ChainError(f"Bone '{root.name}' has no parent to attach to: a rod hangs from a kinematic bone")
+        raise ChainError(
+            f"Bone '{root.name}' has no parent to attach to: a rod hangs from a kinematic bone"
+        )
     reference = root.parent
     if rod.reference_bone:
         reference = bones.get(rod.reference_bone)
         if reference is None:
-            raise ChainError(f"Reference bone '{rod.reference_bone}' of rod '{root.name}' is missing")
+            raise ChainError(
+                f"Reference bone '{rod.reference_bone}' of rod '{root.name}' is missing"
+            )
     return root.parent, reference, chain_from(root)
 
 

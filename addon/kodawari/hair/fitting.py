@@ -1,4 +1,4 @@
-"""Sketch editing (SEEDS.md section 2, "Tooling described"): the chain takes the shape
+"""Sketch editing (docs/algorithms.md §3.6): the chain takes the shape
 of one stroke as seen from the current view. The stroke is projected onto the plane
 through the chain root facing the view, resampled by the bone lengths from the root,
 and each bone is turned (no twist) to point at its resampled joint."""
@@ -42,10 +42,10 @@ def resample(polyline, start, lengths):
             qa, qb, qc = d.dot(d), 2 * f.dot(d), f.dot(f) - length * length
             disc = qb * qb - 4 * qa * qc
             if qa > 1e-18 and disc >= 0:
-                t = (-qb + disc ** 0.5) / (2 * qa)
+                t = (-qb + disc**0.5) / (2 * qa)
                 if 0.0 <= t <= 1.0:
                     found = a + d * t
-                    polyline = [found] + polyline[segment + 1:]
+                    polyline = [found] + polyline[segment + 1 :]
                     segment = 0
                     break
             segment += 1

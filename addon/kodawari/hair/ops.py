@@ -4,10 +4,12 @@ nothing when it refuses (a clear report, {'CANCELLED'})."""
 import math
 
 import bpy
-import numpy as np
-from mathutils import Quaternion, Vector
+from mathutils import Vector
 
+from .. import editable
+from ..bake_job import BakeError, BakeOperator, frame_range
 from . import chains, fitting, props, runtime
+from .bake import HairBakeJob
 
 
 class _Refusal(Exception):
@@ -18,6 +20,9 @@ def _armature(context):
     obj = context.active_object
     if obj is None or obj.type != "ARMATURE":
         raise _Refusal("Select an armature: the active object is not an armature")
+    why = editable.why_not(obj, "change its hair")
+    if why:
+        raise _Refusal(why)
     return obj
 
 
@@ -27,7 +32,9 @@ def _rod(obj, index):
         raise _Refusal("This armature has no rods: add one with Add Rod (kodawari.rod_add)")
     i = settings.active_rod if index < 0 else index
     if i >= len(settings.rods):
-        raise _Refusal(f"Rod index {i} is out of range (the armature has {len(settings.rods)} rods)")
+        raise _Refusal(
+            f"Rod index {i} is out of range (the armature has {len(settings.rods)} rods)"
+        )
     return i, settings.rods[i]
 
 
@@ -44,10 +51,15 @@ def _pose_shape(chain):
     """The chain's current pose as per-joint rotations; refuses NaN or zero quaternions."""
     shape = []
     for pb in chain:
-        q = tuple(pb.rotation_quaternion) if pb.rotation_mode == "QUATERNION" else \
-            tuple(pb.matrix_basis.to_quaternion())
+        q = (
+            tuple(pb.rotation_quaternion)
+            if pb.rotation_mode == "QUATERNION"
+            else tuple(pb.matrix_basis.to_quaternion())
+        )
         if not chains.finite_quaternions(q):
-            raise _Refusal(f"Bone '{pb.name}' has an invalid rotation (NaN or zero): fix the pose before keying")
+            raise _Refusal(
+                f"Bone '{pb.name}' has an invalid rotation (NaN or zero): fix the pose before keying"
+            )
         n = math.sqrt(sum(c * c for c in q))
         shape.append(tuple(c / n for c in q))
     return shape
@@ -131,7 +143,9 @@ class KODAWARI_OT_rod_add(_HairOperator, bpy.types.Operator):
         plans = []
         for root in roots:
             if root.parent is None:
-                raise _Refusal(f"Bone '{root.name}' has no parent to attach to: a rod hangs from a kinematic bone")
+                raise _Refusal(
+                    f"Bone '{root.name}' has no parent to attach to: a rod hangs from a kinematic bone"
+                )
             try:
                 chain = chains.chain_from(root)
             except chains.ChainError as exc:
@@ -144,7 +158,9 @@ class KODAWARI_OT_rod_add(_HairOperator, bpy.types.Operator):
         settings = obj.kodawari_hair
         for root, chain in plans:
             rod = settings.rods.add()
-            rod.root_bone = root.name
+            rod.root_bone = (
+                root.name
+            )  # tags the root bone with the rod's identity (props._root_changed)
             for bone in chain:
                 pb = obj.pose.bones[bone.name]
                 if pb.rotation_mode != "QUATERNION":
@@ -165,7 +181,9 @@ class KODAWARI_OT_rod_remove(_HairOperator, bpy.types.Operator):
     bl_idname = "kodawari.rod_remove"
     bl_label = "Remove Rod"
     bl_options = {"REGISTER", "UNDO"}
-    rod_index: bpy.props.IntProperty(name="Rod", default=-1, description="-1: the active rod")
+    rod_index: bpy.props.IntProperty(
+        name="Rod", default=-1, description="Which rod (-1: the active one)"
+    )
 
     def run(self, context):
         obj = _armature(context)
@@ -186,12 +204,24 @@ class KODAWARI_OT_rod_key_view(_HairOperator, bpy.types.Operator):
     bl_label = "Key View"
     bl_options = {"REGISTER", "UNDO"}
     source: bpy.props.EnumProperty(
-        name="Source", default="CAMERA",
-        items=(("CAMERA", "Camera", "Look through the scene's active camera"),
-               ("VIEWPORT", "Viewport", "The 3D viewport's view")))
-    influence: bpy.props.FloatProperty(name="Influence", default=props.DEFAULT_INFLUENCE, min=0.01, soft_max=64.0,
-                                       description="Default: half weight 60 degrees away")
-    rod_index: bpy.props.IntProperty(name="Rod", default=-1, description="-1: the active rod")
+        name="Source",
+        default="CAMERA",
+        items=(
+            ("CAMERA", "Camera", "Look through the scene's active camera"),
+            ("VIEWPORT", "Viewport", "The 3D viewport's view"),
+        ),
+        description="Which view to key the shape for",
+    )
+    influence: bpy.props.FloatProperty(
+        name="Influence",
+        default=props.DEFAULT_INFLUENCE,
+        min=0.01,
+        soft_max=64.0,
+        description="How narrowly the shape applies (the default: half strength 60° away)",
+    )
+    rod_index: bpy.props.IntProperty(
+        name="Rod", default=-1, description="Which rod (-1: the active one)"
+    )
 
     def run(self, context):
         obj = _armature(context)
@@ -214,7 +244,9 @@ def view_direction(obj, reference, eye_world):
     rotation = reference.matrix.to_quaternion()
     d = rotation.inverted() @ (eye - reference.matrix.translation)
     if d.length < 1e-6:
-        raise _Refusal(f"The camera is at the reference bone '{reference.name}': the view direction is undefined")
+        raise _Refusal(
+            f"The camera is at the reference bone '{reference.name}': the view direction is undefined"
+        )
     return d.normalized()
 
 
@@ -224,8 +256,16 @@ class KODAWARI_OT_rod_key_pose(_HairOperator, bpy.types.Operator):
     bl_idname = "kodawari.rod_key_pose"
     bl_label = "Key Pose"
     bl_options = {"REGISTER", "UNDO"}
-    influence: bpy.props.FloatProperty(name="Influence", default=props.DEFAULT_INFLUENCE, min=0.01, soft_max=64.0)
-    rod_index: bpy.props.IntProperty(name="Rod", default=-1, description="-1: the active rod")
+    influence: bpy.props.FloatProperty(
+        name="Influence",
+        default=props.DEFAULT_INFLUENCE,
+        min=0.01,
+        soft_max=64.0,
+        description="How narrowly the shape applies (the default: half strength 60° away)",
+    )
+    rod_index: bpy.props.IntProperty(
+        name="Rod", default=-1, description="Which rod (-1: the active one)"
+    )
 
     def run(self, context):
         obj = _armature(context)
@@ -249,10 +289,23 @@ class KODAWARI_OT_rod_key_speed(_HairOperator, bpy.types.Operator):
     bl_idname = "kodawari.rod_key_speed"
     bl_label = "Key Speed"
     bl_options = {"REGISTER", "UNDO"}
-    speed: bpy.props.FloatProperty(name="Speed", default=2.0, min=0.0, unit="VELOCITY",
-                                   description="The reference bone's speed (m/s) at which this shape applies")
-    influence: bpy.props.FloatProperty(name="Influence", default=props.DEFAULT_INFLUENCE, min=0.01, soft_max=64.0)
-    rod_index: bpy.props.IntProperty(name="Rod", default=-1, description="-1: the active rod")
+    speed: bpy.props.FloatProperty(
+        name="Speed",
+        default=2.0,
+        min=0.0,
+        unit="VELOCITY",
+        description="The reference bone's speed (m/s) at which this shape applies",
+    )
+    influence: bpy.props.FloatProperty(
+        name="Influence",
+        default=props.DEFAULT_INFLUENCE,
+        min=0.01,
+        soft_max=64.0,
+        description="How narrowly the shape applies (the default: half strength 60° away)",
+    )
+    rod_index: bpy.props.IntProperty(
+        name="Rod", default=-1, description="Which rod (-1: the active one)"
+    )
 
     def run(self, context):
         obj = _armature(context)
@@ -282,8 +335,12 @@ class KODAWARI_OT_rod_key_preview(_HairOperator, bpy.types.Operator):
     bl_idname = "kodawari.rod_key_preview"
     bl_label = "Preview Key"
     bl_options = {"REGISTER", "UNDO"}
-    rod_index: bpy.props.IntProperty(name="Rod", default=-1)
-    key_index: bpy.props.IntProperty(name="Key", default=-1)
+    rod_index: bpy.props.IntProperty(
+        name="Rod", default=-1, description="Which rod (-1: the active one)"
+    )
+    key_index: bpy.props.IntProperty(
+        name="Key", default=-1, description="Which key (-1: the active one)"
+    )
 
     def run(self, context):
         obj = _armature(context)
@@ -291,7 +348,9 @@ class KODAWARI_OT_rod_key_preview(_HairOperator, bpy.types.Operator):
         _, key = _key(rod, self.key_index)
         _, _, chain = _chain_pose_bones(obj, rod)
         if len(key.shape) != len(chain):
-            raise _Refusal(f"Key '{key.name}' has {len(key.shape)} joints, the chain has {len(chain)}: re-key it")
+            raise _Refusal(
+                f"Key '{key.name}' has {len(key.shape)} joints, the chain has {len(chain)}: re-key it"
+            )
         for pb, joint in zip(chain, key.shape):
             pb.rotation_mode = "QUATERNION"
             pb.rotation_quaternion = joint.rotation
@@ -305,8 +364,12 @@ class KODAWARI_OT_rod_rekey(_HairOperator, bpy.types.Operator):
     bl_idname = "kodawari.rod_rekey"
     bl_label = "Re-key"
     bl_options = {"REGISTER", "UNDO"}
-    rod_index: bpy.props.IntProperty(name="Rod", default=-1)
-    key_index: bpy.props.IntProperty(name="Key", default=-1)
+    rod_index: bpy.props.IntProperty(
+        name="Rod", default=-1, description="Which rod (-1: the active one)"
+    )
+    key_index: bpy.props.IntProperty(
+        name="Key", default=-1, description="Which key (-1: the active one)"
+    )
 
     def run(self, context):
         obj = _armature(context)
@@ -328,8 +391,12 @@ class KODAWARI_OT_rod_key_remove(_HairOperator, bpy.types.Operator):
     bl_idname = "kodawari.rod_key_remove"
     bl_label = "Delete Key"
     bl_options = {"REGISTER", "UNDO"}
-    rod_index: bpy.props.IntProperty(name="Rod", default=-1)
-    key_index: bpy.props.IntProperty(name="Key", default=-1)
+    rod_index: bpy.props.IntProperty(
+        name="Rod", default=-1, description="Which rod (-1: the active one)"
+    )
+    key_index: bpy.props.IntProperty(
+        name="Key", default=-1, description="Which key (-1: the active one)"
+    )
 
     def run(self, context):
         obj = _armature(context)
@@ -350,16 +417,45 @@ class KODAWARI_OT_rod_collider_add(_HairOperator, bpy.types.Operator):
     bl_label = "Add Collider"
     bl_options = {"REGISTER", "UNDO"}
     bone: bpy.props.StringProperty(name="Bone", description="Empty: the active bone")
-    shape: bpy.props.EnumProperty(name="Shape", items=(("SPHERE", "Sphere", ""), ("CAPSULE", "Capsule", "")))
-    radius: bpy.props.FloatProperty(name="Radius", default=0.1, min=0.0, unit="LENGTH")
-    length: bpy.props.FloatProperty(name="Length", default=0.2, min=0.0, unit="LENGTH")
-    offset: bpy.props.FloatVectorProperty(name="Offset", size=3, unit="LENGTH")
+    shape: bpy.props.EnumProperty(
+        name="Shape",
+        items=(
+            ("SPHERE", "Sphere", "A ball around a point"),
+            ("CAPSULE", "Capsule", "A rounded cylinder along the bone"),
+        ),
+        description="Shape the hair cannot enter",
+    )
+    radius: bpy.props.FloatProperty(
+        name="Radius",
+        default=0.1,
+        min=0.0,
+        unit="LENGTH",
+        subtype="DISTANCE",
+        description="Size of the collider",
+    )
+    length: bpy.props.FloatProperty(
+        name="Length",
+        default=0.2,
+        min=0.0,
+        unit="LENGTH",
+        subtype="DISTANCE",
+        description="Capsule: how far it reaches along the bone",
+    )
+    offset: bpy.props.FloatVectorProperty(
+        name="Offset",
+        size=3,
+        unit="LENGTH",
+        subtype="TRANSLATION",
+        description="Where the collider sits, relative to the bone",
+    )
 
     def run(self, context):
         obj = _armature(context)
         name = self.bone or (obj.data.bones.active.name if obj.data.bones.active else "")
         if not name or name not in obj.data.bones:
-            raise _Refusal(f"Bone '{name}' is not in the armature: pick the bone the collider follows")
+            raise _Refusal(
+                f"Bone '{name}' is not in the armature: pick the bone the collider follows"
+            )
         collider = obj.kodawari_hair.colliders.add()
         collider.bone, collider.shape, collider.radius = name, self.shape, self.radius
         collider.length, collider.offset = self.length, self.offset
@@ -393,10 +489,17 @@ class KODAWARI_OT_rod_fit_stroke(_HairOperator, bpy.types.Operator):
     bl_label = "Fit to Stroke"
     bl_options = {"REGISTER", "UNDO"}
     source: bpy.props.EnumProperty(
-        name="View", default="CAMERA",
-        items=(("CAMERA", "Camera", "As seen through the active camera"),
-               ("VIEWPORT", "Viewport", "As seen in the 3D viewport")))
-    rod_index: bpy.props.IntProperty(name="Rod", default=-1)
+        name="View",
+        default="CAMERA",
+        items=(
+            ("CAMERA", "Camera", "As seen through the active camera"),
+            ("VIEWPORT", "Viewport", "As seen in the 3D viewport"),
+        ),
+        description="Which view the stroke was drawn in",
+    )
+    rod_index: bpy.props.IntProperty(
+        name="Rod", default=-1, description="Which rod (-1: the active one)"
+    )
 
     def invoke(self, context, event):
         if _viewport_eye(context) is not None:
@@ -411,10 +514,14 @@ class KODAWARI_OT_rod_fit_stroke(_HairOperator, bpy.types.Operator):
         parent, _, chain = _chain_pose_bones(obj, rod)
         points, origin = strokes.find_stroke(context, exclude=obj)
         if not points or len(points) < 2:
-            raise _Refusal("No stroke to fit: draw an annotation (or grease-pencil) stroke of two or more points")
+            raise _Refusal(
+                "No stroke to fit: draw an annotation (or grease-pencil) stroke of two or more points"
+            )
         eye, forward, perspective = _eye(context, self.source)
         try:
-            rotations = fitting.fit_chain_to_stroke(obj, parent, chain, points, eye, forward, perspective)
+            rotations = fitting.fit_chain_to_stroke(
+                obj, parent, chain, points, eye, forward, perspective
+            )
         except fitting.FitError as exc:
             raise _Refusal(str(exc)) from None
         for pb, q in zip(chain, rotations):
@@ -424,152 +531,38 @@ class KODAWARI_OT_rod_fit_stroke(_HairOperator, bpy.types.Operator):
         return {"FINISHED"}
 
 
-class KODAWARI_OT_rod_bake(bpy.types.Operator):
+class KODAWARI_OT_rod_bake(BakeOperator, bpy.types.Operator):
     """Bake the simulated rods into F-curves (rotation_quaternion) so renders and exports need no add-on"""
 
     bl_idname = "kodawari.rod_bake"
     bl_label = "Bake Hair"
     bl_options = {"REGISTER", "UNDO"}
-    frame_start: bpy.props.IntProperty(name="Start", default=-1, description="-1: the scene's start frame")
-    frame_end: bpy.props.IntProperty(name="End", default=-1, description="-1: the scene's end frame")
-    new_action: bpy.props.BoolProperty(name="New Action in NLA", default=False,
-                                       description="Bake into a new action pushed to an NLA track")
+    new_action: bpy.props.BoolProperty(
+        name="New Action in NLA",
+        default=False,
+        description="Bake into a new action pushed to an NLA track",
+    )
 
-    _timer = None
-
-    def _prepare(self, context):
-        obj = _armature(context)
-        settings = obj.kodawari_hair
-        if not len(settings.rods):
-            raise _Refusal("This armature has no rods to bake")
-        scene = context.scene
-        start = scene.frame_start if self.frame_start < 0 else self.frame_start
-        end = scene.frame_end if self.frame_end < 0 else self.frame_end
-        if end < start:
-            raise _Refusal(f"End frame {end} is before start frame {start}")
-        rt = runtime.ArmatureRuntime(obj)  # validates every rod before anything changes
-        if rt.error:
-            raise _Refusal(rt.error)
-        self._obj, self._scene = obj, scene
-        self._start, self._end = start, end
-        self._first = min(scene.frame_start, start)  # live resets at the scene's start: so does the bake
-        self._frame = self._first
-        self._original_frame = scene.frame_current
-        self._was_enabled = settings.enabled
-        self._baked = {}
-        self._chains = None
-        if not settings.enabled:
-            settings.enabled = True
-        runtime.invalidate(obj)
-
-    def _advance(self):
-        """Simulates the next frame (through the live handler); True when all are done."""
-        scene, obj = self._scene, self._obj
-        scene.frame_set(self._frame)
-        rt = runtime.get(obj)
-        if self._chains is None:
-            self._chains = [name for i in sorted(rt.rod_chains) for name in rt.rod_chains[i]]
-        if self._frame >= self._start:
-            self._baked[self._frame] = rt.cached_rotations(self._frame)
-        self._frame += 1
-        return self._frame > self._end
-
-    def _restore(self):
-        self._obj.kodawari_hair.enabled = self._was_enabled
-        self._scene.frame_set(self._original_frame)
-
-    def _finish(self, context):
-        from .. import fcurves
-
-        obj = self._obj
-        frames = np.array(sorted(self._baked), dtype=np.float32)
-        values = np.stack([self._baked[int(f)] for f in frames])  # (F, bones, 4)
-        anim = obj.animation_data or obj.animation_data_create()
-        if self.new_action:
-            previous = anim.action
-            previous_slot = getattr(anim, "action_slot", None)
-            anim.action = None
-            action = fcurves.ensure_action(obj, f"{obj.name}_HairBake")
-            self._write(fcurves, action, frames, values)
-            track = anim.nla_tracks.new()
-            track.name = "Kodawari Hair Bake"
-            strip = track.strips.new(action.name, int(frames[0]), action)
-            if hasattr(strip, "action_slot") and strip.action_slot is None and len(action.slots):
-                strip.action_slot = action.slots[0]
-            anim.action = previous
-            if previous is not None and previous_slot is not None:
-                anim.action_slot = previous_slot
-        else:
-            action = fcurves.ensure_action(obj, f"{obj.name}Action")
-            self._write(fcurves, action, frames, values)
-        # The bake now plays back: the live simulation would only repeat it.
-        obj.kodawari_hair.enabled = False
-        self._scene.frame_set(self._original_frame)
-        self.report({"INFO"}, f"Baked {len(self._chains)} bones over frames {self._start}-{self._end} into "
-                              f"action '{action.name}'" + (" (NLA track)" if self.new_action else "")
-                              + "; live simulation turned off")
-
-    def _write(self, fcurves, action, frames, values):
-        for b, name in enumerate(self._chains):
-            fcurves.write_channels(action, self._obj, f'pose.bones["{name}"].rotation_quaternion', frames,
-                                   values[:, b, :], group=name)
-
-    def execute(self, context):
+    def make_job(self, context):
         try:
-            self._prepare(context)
+            obj = _armature(context)
         except _Refusal as refusal:
-            self.report({"ERROR"}, str(refusal))
-            return {"CANCELLED"}
-        wm = context.window_manager
-        wm.progress_begin(self._first, self._end)
-        try:
-            while not self._advance():
-                wm.progress_update(self._frame)
-        finally:
-            wm.progress_end()
-        self._finish(context)
-        return {"FINISHED"}
-
-    def invoke(self, context, event):
-        if bpy.app.background or context.window is None:
-            return self.execute(context)
-        try:
-            self._prepare(context)
-        except _Refusal as refusal:
-            self.report({"ERROR"}, str(refusal))
-            return {"CANCELLED"}
-        wm = context.window_manager
-        wm.progress_begin(self._first, self._end)
-        self._timer = wm.event_timer_add(0.001, window=context.window)
-        wm.modal_handler_add(self)
-        return {"RUNNING_MODAL"}
-
-    def modal(self, context, event):
-        wm = context.window_manager
-        if event.type == "ESC":
-            wm.event_timer_remove(self._timer)
-            wm.progress_end()
-            self._restore()  # nothing was written yet: F-curves are written only at the end
-            self.report({"WARNING"}, "Hair bake cancelled: nothing changed")
-            return {"CANCELLED"}
-        if event.type != "TIMER":
-            return {"PASS_THROUGH"}
-        done = False
-        for _ in range(4):
-            done = self._advance()
-            if done:
-                break
-        wm.progress_update(self._frame)
-        if done:
-            wm.event_timer_remove(self._timer)
-            wm.progress_end()
-            self._finish(context)
-            return {"FINISHED"}
-        return {"RUNNING_MODAL"}
+            raise BakeError(str(refusal)) from None
+        start, end = frame_range(self, context.scene)
+        return HairBakeJob(obj, context.scene, start, end, self.new_action)
 
 
 CLASSES = (
-    KODAWARI_OT_rod_add, KODAWARI_OT_rod_remove, KODAWARI_OT_rod_key_view, KODAWARI_OT_rod_key_pose,
-    KODAWARI_OT_rod_key_speed, KODAWARI_OT_rod_key_preview, KODAWARI_OT_rod_rekey, KODAWARI_OT_rod_key_remove,
-    KODAWARI_OT_rod_collider_add, KODAWARI_OT_rod_collider_remove, KODAWARI_OT_rod_fit_stroke, KODAWARI_OT_rod_bake,
+    KODAWARI_OT_rod_add,
+    KODAWARI_OT_rod_remove,
+    KODAWARI_OT_rod_key_view,
+    KODAWARI_OT_rod_key_pose,
+    KODAWARI_OT_rod_key_speed,
+    KODAWARI_OT_rod_key_preview,
+    KODAWARI_OT_rod_rekey,
+    KODAWARI_OT_rod_key_remove,
+    KODAWARI_OT_rod_collider_add,
+    KODAWARI_OT_rod_collider_remove,
+    KODAWARI_OT_rod_fit_stroke,
+    KODAWARI_OT_rod_bake,
 )

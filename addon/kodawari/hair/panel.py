@@ -1,14 +1,28 @@
-"""The Kodawari Hair panel (Object Data properties of an armature)."""
+"""The Kodawari Hair panel (Object Data properties of an armature with rods), in
+Blender's layout: the rod list on top, the active rod's settings, its keys and the
+colliders in sub-panels, the solver quality closed by default."""
+
+# bl_options sets are Blender's class-attribute convention, never mutated.
+# ruff: noqa: RUF012
 
 import bpy
+from bpy.app.translations import pgettext_iface as iface_
 
+from .. import in_use, problems
 from . import runtime
+
+CONDITION_ICONS = {"VIEW": "CAMERA_DATA", "POSE": "ARMATURE_DATA", "SPEED": "FORCE_WIND"}
+
+
+def _count(n, one, many):
+    return iface_(one) if n == 1 else iface_(many).format(n)
 
 
 class KODAWARI_UL_hair_rods(bpy.types.UIList):
     def draw_item(self, context, layout, data, item, icon, active_data, active_propname, index=0):
-        layout.label(text=item.root_bone or "(no bone)", icon="BONE_DATA")
-        layout.label(text=f"{len(item.keys)} keys")
+        row = layout.row()
+        row.label(text=item.root_bone or iface_("(no bone)"), icon="BONE_DATA", translate=False)
+        row.label(text=_count(len(item.keys), "1 key", "{} keys"), translate=False)
 
 
 class KODAWARI_UL_hair_keys(bpy.types.UIList):
@@ -16,28 +30,51 @@ class KODAWARI_UL_hair_keys(bpy.types.UIList):
 
     def draw_item(self, context, layout, data, item, icon, active_data, active_propname, index=0):
         row = layout.row(align=True)
-        row.prop(item, "name", text="", emboss=False, icon={"VIEW": "CAMERA_DATA", "POSE": "ARMATURE_DATA",
-                                                             "SPEED": "FORCE_WIND"}[item.condition])
+        row.prop(item, "name", text="", emboss=False, icon=CONDITION_ICONS[item.condition])
         obj = data.id_data
         rt = runtime.get(obj, build=False)
         weight = None
         if rt is not None:
-            rod_index = list(obj.kodawari_hair.rods).index(data) if data in list(obj.kodawari_hair.rods) else -1
+            rods = list(obj.kodawari_hair.rods)
+            rod_index = rods.index(data) if data in rods else -1
             weights = rt.weights(rod_index)
             if weights is not None and index + 1 < len(weights):
                 weight = weights[index + 1]
-        row.label(text="–" if weight is None else f"{weight:.2f}")
+        row.label(text="–" if weight is None else f"{weight:.2f}", translate=False)
 
 
-class KODAWARI_PT_hair(bpy.types.Panel):
-    bl_label = "Kodawari Hair"
+class KODAWARI_UL_hair_colliders(bpy.types.UIList):
+    def draw_item(self, context, layout, data, item, icon, active_data, active_propname, index=0):
+        row = layout.row()
+        shape_icon = "MESH_UVSPHERE" if item.shape == "SPHERE" else "MESH_CAPSULE"
+        row.label(text=item.bone or iface_("(no bone)"), icon=shape_icon, translate=False)
+        row.prop(item, "shape", text="", emboss=False)
+
+
+def _split(layout):
+    layout.use_property_split = True
+    layout.use_property_decorate = True
+    return layout
+
+
+def _active_rod(settings):
+    if settings.rods and 0 <= settings.active_rod < len(settings.rods):
+        return settings.rods[settings.active_rod]
+    return None
+
+
+class _HairPanel:
     bl_space_type = "PROPERTIES"
     bl_region_type = "WINDOW"
     bl_context = "data"
 
     @classmethod
     def poll(cls, context):
-        return context.object is not None and context.object.type == "ARMATURE"
+        return in_use.hair(context.object)
+
+
+class KODAWARI_PT_hair(_HairPanel, bpy.types.Panel):
+    bl_label = "Kodawari Hair"
 
     def draw_header(self, context):
         self.layout.prop(context.object.kodawari_hair, "enabled", text="")
@@ -47,60 +84,130 @@ class KODAWARI_PT_hair(bpy.types.Panel):
         obj = context.object
         settings = obj.kodawari_hair
         rt = runtime.get(obj, build=False)
-        if rt is not None and (rt.error or rt.status):
-            layout.label(text=rt.error or rt.status, icon="ERROR")
+        problem = (rt.error or rt.status) if rt is not None else ""
+        problem = problem or problems.message(obj, "hair")
+        if problem:
+            layout.label(text=problem, icon="ERROR", translate=False)
+        layout.template_list("KODAWARI_UL_hair_rods", "", settings, "rods", settings, "active_rod", rows=3)
+        row = layout.row(align=True)
+        row.operator("kodawari.rod_add", text="Add Rod", icon="ADD")
+        row.operator("kodawari.rod_remove", text="Remove Rod", icon="REMOVE")
+        layout.operator("kodawari.rod_bake", icon="REC")
+
+
+class KODAWARI_PT_hair_rod(_HairPanel, bpy.types.Panel):
+    bl_label = "Rod"
+    bl_parent_id = "KODAWARI_PT_hair"
+
+    @classmethod
+    def poll(cls, context):
+        return in_use.hair(context.object) and _active_rod(context.object.kodawari_hair) is not None
+
+    def draw(self, context):
+        layout = _split(self.layout)
+        obj = context.object
+        rod = _active_rod(obj.kodawari_hair)
+        col = layout.column()
+        col.prop_search(rod, "reference_bone", obj.data, "bones", text="Reference")
+        col = layout.column()
+        col.prop(rod, "stiffness", slider=True)
+        col.prop(rod, "damping")
+        col.prop(rod, "gravity")
+        layout.column().prop(rod, "wind")
+
+
+class KODAWARI_PT_hair_rod_quality(_HairPanel, bpy.types.Panel):
+    bl_label = "Collision and Quality"
+    bl_parent_id = "KODAWARI_PT_hair_rod"
+    bl_options = {"DEFAULT_CLOSED"}
+
+    @classmethod
+    def poll(cls, context):
+        return KODAWARI_PT_hair_rod.poll(context)
+
+    def draw(self, context):
+        layout = _split(self.layout)
+        rod = _active_rod(context.object.kodawari_hair)
+        col = layout.column()
+        col.prop(rod, "radius")
+        col.prop(rod, "substeps")
+        col.prop(rod, "iterations")
+
+
+class KODAWARI_PT_hair_keys(_HairPanel, bpy.types.Panel):
+    bl_label = "Keys"
+    bl_parent_id = "KODAWARI_PT_hair"
+
+    @classmethod
+    def poll(cls, context):
+        return KODAWARI_PT_hair_rod.poll(context)
+
+    def draw(self, context):
+        layout = self.layout
+        rod = _active_rod(context.object.kodawari_hair)
         row = layout.row()
-        row.template_list("KODAWARI_UL_hair_rods", "", settings, "rods", settings, "active_rod", rows=3)
+        row.template_list("KODAWARI_UL_hair_keys", "", rod, "keys", rod, "active_key", rows=3)
         col = row.column(align=True)
-        col.operator("kodawari.rod_add", icon="ADD", text="")
-        col.operator("kodawari.rod_remove", icon="REMOVE", text="")
-        if settings.rods and settings.active_rod < len(settings.rods):
-            rod = settings.rods[settings.active_rod]
-            box = layout.box()
-            box.prop_search(rod, "reference_bone", obj.data, "bones")
-            grid = box.grid_flow(columns=2, align=True)
-            for name in ("stiffness", "damping", "gravity", "radius", "substeps", "iterations"):
-                grid.prop(rod, name)
-            box.prop(rod, "wind")
-            layout.label(text="Keys (live weight)")
-            row = layout.row()
-            row.template_list("KODAWARI_UL_hair_keys", "", rod, "keys", rod, "active_key", rows=3)
-            col = row.column(align=True)
-            col.operator("kodawari.rod_key_remove", icon="REMOVE", text="")
-            row = layout.row(align=True)
-            row.operator("kodawari.rod_key_view", text="Key View").source = "CAMERA"
-            row.operator("kodawari.rod_key_pose", text="Key Pose")
-            row.operator("kodawari.rod_key_speed", text="Key Speed")
-            row = layout.row(align=True)
-            row.operator("kodawari.rod_key_preview", text="Preview")
-            row.operator("kodawari.rod_rekey", text="Re-key")
-            row.operator("kodawari.rod_fit_stroke", text="Fit Stroke")
-            if rod.keys and rod.active_key < len(rod.keys):
-                key = rod.keys[rod.active_key]
-                sub = layout.column(align=True)
-                sub.prop(key, "condition")
-                sub.prop(key, "influence")
-                if key.condition == "VIEW":
-                    sub.prop(key, "direction", text="")
-                elif key.condition == "SPEED":
-                    sub.prop(key, "speed")
-        layout.label(text="Colliders")
+        col.menu("KODAWARI_MT_hair_key_add", icon="ADD", text="")
+        col.operator("kodawari.rod_key_remove", icon="REMOVE", text="")
+        row = layout.row(align=True)
+        row.operator("kodawari.rod_key_preview", text="Preview", icon="HIDE_OFF")
+        row.operator("kodawari.rod_rekey", text="Re-key", icon="FILE_REFRESH")
+        layout.operator("kodawari.rod_fit_stroke", icon="GREASEPENCIL")
+        if rod.keys and 0 <= rod.active_key < len(rod.keys):
+            key = rod.keys[rod.active_key]
+            col = _split(layout.column())
+            col.prop(key, "condition")
+            col.prop(key, "influence")
+            if key.condition == "VIEW":
+                col.prop(key, "direction", text="Direction")
+            elif key.condition == "SPEED":
+                col.prop(key, "speed")
+
+
+class KODAWARI_PT_hair_colliders(_HairPanel, bpy.types.Panel):
+    bl_label = "Colliders"
+    bl_parent_id = "KODAWARI_PT_hair"
+    bl_options = {"DEFAULT_CLOSED"}
+
+    def draw(self, context):
+        layout = self.layout
+        obj = context.object
+        settings = obj.kodawari_hair
         row = layout.row()
-        row.template_list("UI_UL_list", "kodawari_colliders", settings, "colliders", settings, "active_collider",
+        row.template_list("KODAWARI_UL_hair_colliders", "", settings, "colliders", settings, "active_collider",
                           rows=2)
         col = row.column(align=True)
         col.operator("kodawari.rod_collider_add", icon="ADD", text="")
         col.operator("kodawari.rod_collider_remove", icon="REMOVE", text="")
-        if settings.colliders and settings.active_collider < len(settings.colliders):
-            c = settings.colliders[settings.active_collider]
-            box = layout.box()
-            box.prop_search(c, "bone", obj.data, "bones")
-            box.prop(c, "shape")
-            box.prop(c, "radius")
-            if c.shape == "CAPSULE":
-                box.prop(c, "length")
-            box.prop(c, "offset")
-        layout.operator("kodawari.rod_bake", icon="REC")
+        if settings.colliders and 0 <= settings.active_collider < len(settings.colliders):
+            collider = settings.colliders[settings.active_collider]
+            col = _split(layout.column())
+            col.prop_search(collider, "bone", obj.data, "bones")
+            col.prop(collider, "shape")
+            col.prop(collider, "radius")
+            if collider.shape == "CAPSULE":
+                col.prop(collider, "length")
+            col.prop(collider, "offset")
 
 
-CLASSES = (KODAWARI_UL_hair_rods, KODAWARI_UL_hair_keys, KODAWARI_PT_hair)
+class KODAWARI_PT_hair_add(bpy.types.Panel):
+    """On an armature without rods: one "Add Hair Rod" button."""
+
+    bl_label = "Kodawari Hair"
+    bl_space_type = "PROPERTIES"
+    bl_region_type = "WINDOW"
+    bl_context = "data"
+    bl_options = {"HIDE_HEADER"}
+
+    @classmethod
+    def poll(cls, context):
+        return in_use.can_rig(context.object) and not in_use.hair(context.object)
+
+    def draw(self, context):
+        self.layout.operator("kodawari.rod_add", text="Add Hair Rod (selected bones)", icon="STRANDS")
+
+
+CLASSES = (KODAWARI_UL_hair_rods, KODAWARI_UL_hair_keys, KODAWARI_UL_hair_colliders, KODAWARI_PT_hair_add,
+           KODAWARI_PT_hair,
+           KODAWARI_PT_hair_rod, KODAWARI_PT_hair_rod_quality, KODAWARI_PT_hair_keys, KODAWARI_PT_hair_colliders)

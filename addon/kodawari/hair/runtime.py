@@ -4,13 +4,18 @@ and what the panel shows (live weights, status).
 Frames are simulated in order; every simulated frame caches the full solver state
 (inside the native system: no state array crosses into Python per frame), so scrubbing
 back is exact and playing on from any cached frame continues exactly. Jumping to (or
-before) the start frame resets. One crossing into C++ per frame: the pose-bone matrices
-the rods need in, all rod-bone rotations out, through foreach_get/set.
+before) the start frame resets; jumping past the cached frames plays the skipped frames
+in order, so a jump gives the pose playback gives (docs/algorithms.md §3.5). The cache
+keeps to a memory budget (add-on preference) by thinning to checkpoints. One crossing
+into C++ per frame: the pose-bone matrices the rods need in, all rod-bone rotations
+out, through foreach_get/set. Inputs are read from the evaluated object of the
+depsgraph being evaluated, so a render (whose depsgraph is not the viewport's) sees the
+pose it renders.
 """
 
 import numpy as np
 
-from .. import native
+from .. import native, problems
 from . import chains
 
 # The solver state of the last evaluated frame is saved into the .blend (save_pre)
@@ -20,6 +25,23 @@ STATE_FRAME_PROPERTY = "kodawari_hair_state_frame"
 NO_CAMERA = "No active camera: view keys fall back to the base shape"
 
 _runtimes = {}
+# True while evaluate() plays skipped frames through scene.frame_set (their handlers
+# must simulate them in order, not jump again).
+_replaying = False
+DEFAULT_CACHE_MEGABYTES = 256
+
+
+def cache_budget_bytes():
+    """The frame-cache budget from the add-on preferences (default 256 MB)."""
+    import bpy
+
+    from ..preferences import addon_package
+
+    addon = bpy.context.preferences.addons.get(addon_package())
+    megabytes = getattr(
+        getattr(addon, "preferences", None), "hair_cache_megabytes", DEFAULT_CACHE_MEGABYTES
+    )
+    return int(megabytes) << 20
 
 
 def active_camera(scene, frame):
@@ -59,6 +81,7 @@ class ArmatureRuntime:
         self.bone_count = len(pose_bones)
         index = {pb.name: i for i, pb in enumerate(pose_bones)}
         self.system = kn.RodSystem(self.bone_count, 0)
+        self.system.cache_budget = cache_budget_bytes()
         self.rod_slots = {}  # index in settings.rods -> index in the native system
         self.rod_chains = {}  # index in settings.rods -> chain bone names
         rod_bones = []
@@ -71,21 +94,38 @@ class ArmatureRuntime:
                 shapes = np.zeros((m, n, 4))
                 for j, key in enumerate(rod.keys):
                     if len(key.shape) != n:
-                        raise chains.ChainError(f"Key '{key.name}' of rod '{rod.root_bone}' has {len(key.shape)} "
-                                                f"joints, the chain has {n}: re-key it")
+                        raise chains.ChainError(
+                            f"Key '{key.name}' of rod '{rod.root_bone}' has {len(key.shape)} "
+                            f"joints, the chain has {n}: re-key it"
+                        )
                     for k, joint in enumerate(key.shape):
                         shapes[j, k] = joint.rotation
                 slot = self.system.add_rod(
-                    index[parent.name], index[reference.name], np.array([index[b.name] for b in chain], np.int32),
-                    offsets, rest, stiffness=rod.stiffness, damping=rod.damping, gravity=rod.gravity,
-                    substeps=rod.substeps, iterations=rod.iterations, radius=rod.radius,
+                    index[parent.name],
+                    index[reference.name],
+                    np.array([index[b.name] for b in chain], np.int32),
+                    offsets,
+                    rest,
+                    stiffness=rod.stiffness,
+                    damping=rod.damping,
+                    gravity=rod.gravity,
+                    substeps=rod.substeps,
+                    iterations=rod.iterations,
+                    radius=rod.radius,
                     wind=np.array(rod.wind, np.float64),
-                    key_conditions=np.array([props.CONDITION_CODES[k.condition] for k in rod.keys], np.int32),
-                    key_directions=np.array([tuple(k.direction) for k in rod.keys], np.float64).reshape(m, 3),
-                    key_rotations=np.array([tuple(k.rotation) for k in rod.keys], np.float64).reshape(m, 4),
+                    key_conditions=np.array(
+                        [props.CONDITION_CODES[k.condition] for k in rod.keys], np.int32
+                    ),
+                    key_directions=np.array(
+                        [tuple(k.direction) for k in rod.keys], np.float64
+                    ).reshape(m, 3),
+                    key_rotations=np.array(
+                        [tuple(k.rotation) for k in rod.keys], np.float64
+                    ).reshape(m, 4),
                     key_speeds=np.array([k.speed for k in rod.keys], np.float64),
                     key_influences=np.array([k.influence for k in rod.keys], np.float64),
-                    key_shapes=shapes.reshape(m * n, 4))
+                    key_shapes=shapes.reshape(m * n, 4),
+                )
             except ValueError as exc:  # ChainError is a ValueError, as are the solver's refusals
                 errors.append(str(exc))
                 continue
@@ -93,13 +133,18 @@ class ArmatureRuntime:
             self.rod_chains[i] = [b.name for b in chain]
             rod_bones.extend(index[b.name] for b in chain)
         colliders = [c for c in settings.colliders if c.bone in index]
-        errors.extend(f"Collider bone '{c.bone}' is missing" for c in settings.colliders if c.bone not in index)
+        errors.extend(
+            f"Collider bone '{c.bone}' is missing"
+            for c in settings.colliders
+            if c.bone not in index
+        )
         self.system.set_colliders(
             np.array([index[c.bone] for c in colliders], np.int32),
             np.array([1 if c.shape == "CAPSULE" else 0 for c in colliders], np.int32),
             np.array([tuple(c.offset) for c in colliders], np.float64).reshape(-1, 3),
             np.array([c.radius for c in colliders], np.float64),
-            np.array([c.length for c in colliders], np.float64))
+            np.array([c.length for c in colliders], np.float64),
+        )
         self.error = "; ".join(errors)
         self.status = ""
         self.rod_bones = np.array(rod_bones, dtype=np.int64)
@@ -114,7 +159,9 @@ class ArmatureRuntime:
                 parent, reference, _chain = chains.resolve_rod(obj, rod)
                 read.update((index[parent.name], index[reference.name]))
         read.update(index[c.bone] for c in colliders)
-        self.matrix_bones = sorted(read) if len(read) * SPARSE_READ_RATIO <= self.bone_count else None
+        self.matrix_bones = (
+            sorted(read) if len(read) * SPARSE_READ_RATIO <= self.bone_count else None
+        )
         others = sorted(set(range(self.bone_count)) - set(rod_bones))
         self.other_bones = others if len(others) * SPARSE_READ_RATIO <= self.bone_count else None
         self.last_frame = None
@@ -126,8 +173,24 @@ class ArmatureRuntime:
             return
         for i in self.matrix_bones:
             m = pose_bones[i].matrix  # row-major; the solver takes foreach_get's column-major rows
-            self.matrices[i] = (m[0][0], m[1][0], m[2][0], m[3][0], m[0][1], m[1][1], m[2][1], m[3][1],
-                                m[0][2], m[1][2], m[2][2], m[3][2], m[0][3], m[1][3], m[2][3], m[3][3])
+            self.matrices[i] = (
+                m[0][0],
+                m[1][0],
+                m[2][0],
+                m[3][0],
+                m[0][1],
+                m[1][1],
+                m[2][1],
+                m[3][1],
+                m[0][2],
+                m[1][2],
+                m[2][2],
+                m[3][2],
+                m[0][3],
+                m[1][3],
+                m[2][3],
+                m[3][3],
+            )
 
     def _read_other_rotations(self, pose_bones):
         """The current rotations of the bones the solver does not write (foreach_set writes all)."""
@@ -137,15 +200,20 @@ class ArmatureRuntime:
         for i in self.other_bones:
             self.rotations[i] = pose_bones[i].rotation_quaternion
 
-    def _inputs(self, obj, scene, frame):
-        pose_bones = obj.pose.bones
+    def _inputs(self, obj, scene, frame, depsgraph):
+        evaluated = _evaluated(obj, depsgraph)
+        pose_bones = evaluated.pose.bones
         self._read_matrices(pose_bones)
         self._read_other_rotations(pose_bones)
         camera = active_camera(scene, frame)
         self.status = "" if camera is not None else NO_CAMERA
-        camera_position = None if camera is None else np.array(camera.matrix_world.translation, np.float64)
+        camera_position = None
+        if camera is not None:
+            camera_position = np.array(
+                _evaluated(camera, depsgraph).matrix_world.translation, np.float64
+            )
         gravity = np.array(scene.gravity if scene.use_gravity else (0.0, 0.0, 0.0), np.float64)
-        armature_matrix = np.array([tuple(row) for row in obj.matrix_world], np.float64)
+        armature_matrix = np.array([tuple(row) for row in evaluated.matrix_world], np.float64)
         return armature_matrix, camera_position, gravity
 
     def _write(self, obj):
@@ -161,29 +229,52 @@ class ArmatureRuntime:
         """Rotations (rod bones, 4) written at a cached frame, rod by rod, root first."""
         return self.system.cached_rotations(frame)
 
-    def evaluate(self, obj, scene, frame):
+    def evaluate(self, obj, scene, frame, depsgraph=None):
         """Simulates (or recalls) `frame` and writes the rod bones' rotations."""
         if self.system.rod_count == 0:
             self.status = ""
             return
-        if frame > scene.frame_start and frame in self.system.cached_frames():
-            self._read_other_rotations(obj.pose.bones)
-            self.system.recall_frame(frame, self.rotations, load_state=self.last_frame != frame)
-            self.last_frame = frame
-            self.status = "" if active_camera(scene, frame) is not None else NO_CAMERA
-            self._write(obj)
+        if frame > scene.frame_start:
+            self._read_other_rotations(_evaluated(obj, depsgraph).pose.bones)
+            if self.system.recall_frame(frame, self.rotations, load_state=self.last_frame != frame):
+                self.last_frame = frame
+                self.status = "" if active_camera(scene, frame) is not None else NO_CAMERA
+                self._write(obj)
+                return
+        # The frame before, from the solver's own state when it was the last one simulated (the
+        # budget may already have dropped it from the cache), else the latest cached one.
+        if self.last_frame == frame - 1:
+            previous = self.last_frame
+        else:
+            previous = self.system.latest_cached_frame_before(frame)
+        if (
+            frame > scene.frame_start
+            and (previous is None or previous < frame - 1)
+            and _can_replay(depsgraph)
+        ):
+            # A jump past the cached frames (or to a dropped one): play the frames in between
+            # as playback would, each evaluated by Blender and simulated by this handler.
+            _replay(scene, scene.frame_start if previous is None else previous + 1, frame)
             return
         fps = scene.render.fps / scene.render.fps_base
-        armature_matrix, camera, gravity = self._inputs(obj, scene, frame)
-        previous = self.system.latest_cached_frame_before(frame)
+        armature_matrix, camera, gravity = self._inputs(obj, scene, frame, depsgraph)
         if frame <= scene.frame_start or previous is None:
             self.system.clear_cache()
-            self.system.reset(self.matrices, armature_matrix, camera, gravity, frame / fps, self.rotations)
+            self.system.reset(
+                self.matrices, armature_matrix, camera, gravity, frame / fps, self.rotations
+            )
         else:
             if self.last_frame != previous:
                 self.system.recall_frame(previous)
-            self.system.step(self.matrices, armature_matrix, camera, gravity, frame / fps,
-                             (frame - previous) / fps, self.rotations)
+            self.system.step(
+                self.matrices,
+                armature_matrix,
+                camera,
+                gravity,
+                frame / fps,
+                (frame - previous) / fps,
+                self.rotations,
+            )
         self.system.store_frame(frame, self.rotations)
         self.last_frame = frame
         self._write(obj)
@@ -193,6 +284,27 @@ class ArmatureRuntime:
         if slot is None or self.last_frame is None:
             return None
         return self.system.weights(slot)
+
+
+def _evaluated(obj, depsgraph):
+    """The object as `depsgraph` evaluated it (a render's own copy during a render)."""
+    return obj.evaluated_get(depsgraph) if depsgraph is not None else obj
+
+
+def _can_replay(depsgraph):
+    """Skipped frames are played through scene.frame_set, which only the viewport's own
+    evaluation may do (not a render's depsgraph, not a nested replay)."""
+    return not _replaying and (depsgraph is None or depsgraph.mode != "RENDER")
+
+
+def _replay(scene, first, last):
+    global _replaying
+    _replaying = True
+    try:
+        for frame in range(first, last + 1):
+            scene.frame_set(frame)  # frame_change_post simulates it (previous frame cached)
+    finally:
+        _replaying = False
 
 
 def get(obj, build=True):
@@ -225,13 +337,26 @@ def hair_armatures(scene):
                 yield obj
 
 
-def evaluate_scene(scene):
+def evaluate_scene(scene, depsgraph=None):
     for obj in hair_armatures(scene):
-        rt = get(obj)
+        rt = None
         try:
-            rt.evaluate(obj, scene, scene.frame_current)
+            rt = get(obj)
+            rt.evaluate(obj, scene, scene.frame_current, depsgraph)
         except ValueError as exc:  # e.g. a collapsed (zero-scale) armature: say why, keep the pose
-            rt.status = f"Hair not simulated: {exc}"
+            if rt is not None:
+                rt.status = f"Hair not simulated: {exc}"
+            else:
+                problems.report(obj, "hair", exc)
+        except Exception as exc:  # noqa: BLE001 - one broken rig never stops the others
+            problems.report(obj, "hair", exc)
+            if rt is not None:
+                rt.status = f"Hair not simulated: {problems.message(obj, 'hair')}"
+        else:
+            if rt.error:  # a rod could not be built (its bones deleted or renamed): say so, once
+                problems.report(obj, "hair", ValueError(rt.error))
+            else:
+                problems.clear(obj, "hair")
 
 
 def store_state(obj):

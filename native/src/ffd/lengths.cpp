@@ -29,7 +29,7 @@ Vec3 place_at_distance(const Vec3& anchor, const Vec3& target, const Vec3& fallb
   return anchor + (length / norm) * direction;
 }
 
-// SEEDS §1: from the moved point, toward the head, then toward the tail.
+// docs/algorithms.md §1.5: from the moved point, toward the head, then toward the tail.
 Vec3List seed_pass(const Vec3List& points, const std::vector<Real>& rest_lengths, long moved_index, Real scale) {
   const long n = static_cast<long>(points.size());
   Vec3List out = points;

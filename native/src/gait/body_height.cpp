@@ -8,9 +8,11 @@ namespace kodawari::gait::stages {
 
 namespace {
 
+constexpr Real kMaxDropPitch = 5 * kPi / 180;  // most pitch lowering for reach may add
+
 // Bob (seed: measured body bob replayed) as a dip accumulated in phase, so a change of
 // cycle time never makes it jump; faded in from a stand.
-std::vector<Real> plan_bob(const BakeInput& in, const BodyTrack& track, int frames) {
+std::vector<Real> plan_bob(const BakeInput& in, const BodyTrack& track, const LegGeometry& legs, int frames) {
   const GaitTable& table = in.table;
   std::vector<Real> bob(frames);
   Real phase = 0, amplitude = table.gaits[track.gait[0]].bob;
@@ -19,7 +21,9 @@ std::vector<Real> plan_bob(const BakeInput& in, const BodyTrack& track, int fram
     const GaitParams& g = table.gaits[track.gait[k]];
     const Real frame_dt = 1 / in.fps;
     amplitude += (g.bob - amplitude) * std::min(Real(1), frame_dt / 0.3);
-    if (f > 0) phase += g.bobs_per_cycle * frame_dt / cycle_time(g) * std::min(Real(1), track.speed[k] / 0.5);
+    const Real duty = duty_at(table, static_cast<Gait>(track.gait[k]), track.speed[k], legs.leg_length);
+    const Real T = cycle_time(g.swing_time, duty);
+    if (f > 0) phase += g.bobs_per_cycle * frame_dt / T * std::min(Real(1), track.speed[k] / 0.5);
     const Real fade = std::min(Real(1), track.speed[k] / 0.5);
     bob[f] = amplitude * fade * (1 - std::cos(2 * kPi * phase)) / 2;
   }
@@ -50,7 +54,7 @@ BodyHeight plan_body_height(const BakeInput& in, const LegGeometry& legs, const 
                             const Footfalls& feet) {
   const int frames = static_cast<int>(in.target_speed.size());
   BodyHeight height;
-  height.bob = plan_bob(in, track, frames);
+  height.bob = plan_bob(in, track, legs, frames);
   height.drop_fore.resize(frames);
   height.drop_hind.resize(frames);
   // Lowered wherever a foot, planted or swinging, would be out of its leg's reach, fore
@@ -75,6 +79,17 @@ BodyHeight plan_body_height(const BakeInput& in, const LegGeometry& legs, const 
     }
     height.drop_fore[f] = need[0];
     height.drop_hind[f] = need[1];
+  }
+  // The ends are lowered level rather than pitched: one end is never lowered more than
+  // kMaxDropPitch of pitch beyond the other (the other is lowered too, never raised), so
+  // a leg short of reach bends both ends' legs instead of tipping the body.
+  Real span = 0;
+  for (int leg = 0; leg < kLegCount; ++leg) span += (is_fore(leg) ? 0.5 : -0.5) * legs.root_rel[leg].dot(in.rig.forward);
+  const Real cap = std::abs(span) * std::sin(kMaxDropPitch);
+  for (int f = 0; f < frames; ++f) {
+    const Real fore = height.drop_fore[f], hind = height.drop_hind[f];
+    height.drop_fore[f] = std::max(fore, hind - cap);
+    height.drop_hind[f] = std::max(hind, fore - cap);
   }
   const int radius = std::max(1, static_cast<int>(std::lround(0.08 * in.fps)));
   envelope(height.drop_fore, radius);

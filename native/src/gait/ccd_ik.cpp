@@ -148,6 +148,79 @@ CcdResult solve_ccd(const LegChain& chain, const Vec2& target, int iterations, R
   return result;
 }
 
+CcdResult solve_dls(const LegChain& chain, const Vec2& target, int iterations, Real tolerance, Real* angles) {
+  const int n = chain.size();
+  for (int k = 0; k < n; ++k) {
+    angles[k] = std::isfinite(angles[k]) ? std::clamp(angles[k], chain.limit_min[k], chain.limit_max[k])
+                                         : std::clamp(Real(0), chain.limit_min[k], chain.limit_max[k]);
+  }
+  const Real damping = 1e-3 * chain.length();
+  Vec2 points[kMaxBones + 1];
+  CcdResult result;
+  chain_points(chain, angles, points);
+  result.error = (points[n] - target).norm();
+  for (int it = 0; it < iterations && result.error > tolerance; ++it) {
+    const Vec2 e = target - points[n];
+    Vec2 jac[kMaxBones];
+    for (int k = 0; k < n; ++k) {
+      const Vec2 r = points[n] - points[k];
+      jac[k] = Vec2(r.y(), -r.x());  // d foot / d theta_k: positive theta turns clockwise
+    }
+    // The step over the free joints, each weighted by its stiffness and, near the limit
+    // it turns towards, less and less (weighted least norm, Chan & Dubey 1995): a joint
+    // slows into its limit and the others take over gradually, not in one frame.
+    // A joint on a limit that the step would push past it is held for this step and the
+    // step is taken again without it (an active set).
+    bool held[kMaxBones] = {};
+    Real soft[kMaxBones];
+    Real step[kMaxBones];
+    for (int k = 0; k < n; ++k) soft[k] = 1;
+    for (int pass = 0; pass <= n + 1; ++pass) {
+      Real a00 = damping * damping, a01 = 0, a11 = damping * damping;
+      for (int k = 0; k < n; ++k) {
+        if (held[k]) continue;
+        const Real w = chain.stiffness[k] * soft[k];
+        a00 += w * jac[k].x() * jac[k].x();
+        a01 += w * jac[k].x() * jac[k].y();
+        a11 += w * jac[k].y() * jac[k].y();
+      }
+      const Real det = a00 * a11 - a01 * a01;
+      const Vec2 y = det > 0 ? Vec2((a11 * e.x() - a01 * e.y()) / det, (a00 * e.y() - a01 * e.x()) / det)
+                             : Vec2::Zero();
+      bool changed = false;
+      for (int k = 0; k < n; ++k) {
+        step[k] = held[k] ? 0 : chain.stiffness[k] * soft[k] * y.dot(jac[k]);
+        const bool at_min = angles[k] <= chain.limit_min[k] + 1e-9 && step[k] < 0;
+        const bool at_max = angles[k] >= chain.limit_max[k] - 1e-9 && step[k] > 0;
+        if (!held[k] && (at_min || at_max)) changed = held[k] = true;
+      }
+      if (pass == 0) {  // soften the joints turning into a limit, from the first step's direction
+        for (int k = 0; k < n; ++k) {
+          const Real room = step[k] > 0 ? chain.limit_max[k] - angles[k] : angles[k] - chain.limit_min[k];
+          const Real margin = std::min(Real(0.35), (chain.limit_max[k] - chain.limit_min[k]) / 4);
+          const Real f = margin > 0 ? std::clamp(room / margin, Real(0.05), Real(1)) : Real(1);
+          soft[k] = f * f;
+        }
+        changed = true;
+      }
+      if (!changed) break;
+    }
+    Real largest = 0;
+    for (int k = 0; k < n; ++k) largest = std::max(largest, std::abs(step[k]));
+    if (largest == 0) break;
+    const Real scale = largest > 0.2 ? 0.2 / largest : 1;  // small steps: the linearisation holds
+    for (int k = 0; k < n; ++k) {
+      angles[k] = std::clamp(angles[k] + scale * step[k], chain.limit_min[k], chain.limit_max[k]);
+    }
+    chain_points(chain, angles, points);
+    const Real previous = result.error;
+    result.error = (points[n] - target).norm();
+    result.iterations = it + 1;
+    if (result.error > previous * 0.9999 && scale == 1) break;  // stalled
+  }
+  return result;
+}
+
 Real directional_reach(const LegChain& chain, const Vec2& direction) {
   std::vector<Real> angles(chain.size());
   for (int k = 0; k < chain.size(); ++k) angles[k] = std::clamp(Real(0), chain.limit_min[k], chain.limit_max[k]);

@@ -97,8 +97,11 @@ class FootfallPlanner {
 
  private:
   const GaitParams& params_at(long k) const { return table_.gaits[track_.gait[track_.clamp_step(k)]]; }
-  Real cycle_steps(long k) const { return cycle_time(params_at(k)) / track_.dt; }
-  Real duty(long k) const { return params_at(k).duty_factor; }
+  Real cycle_steps(long k) const { return cycle_time(params_at(k).swing_time, duty(k)) / track_.dt; }
+  Real duty(long k) const {
+    const long c = track_.clamp_step(k);
+    return duty_at(table_, static_cast<Gait>(track_.gait[c]), track_.speed[c], legs_.leg_length);
+  }
   static Real swing_margin(Real v, const GaitParams& p) { return ease_lag(v, p.swing_time); }
 
   Real lh_next_lift() const {

@@ -14,6 +14,12 @@ constexpr Real kIkTolerance = 2e-4;       // m: a planted foot is solved to a fi
 constexpr Real kSwingIkTolerance = 1e-3;  // m: a swinging foot, to a millimetre
 // A swing the leg cannot follow within this (m) is solved again (LegIk::solve_swing).
 constexpr Real kSwingTolerance = 0.01;
+// A stance the leg cannot hold within this (m) going forward is solved again
+// (LegIk::solve_stance).
+constexpr Real kStanceTolerance = 1e-3;
+// A planted foot further than this (m) from its target is a visible slide: only then
+// may its solve restart cold, into another leg configuration.
+constexpr Real kStanceSlide = 3e-3;
 // Shares of the gait's swing lift tried, in order, for a swing the leg cannot follow.
 constexpr Real kLiftScales[] = {1.0, 0.75, 0.5, 0.25, 0.0};
 
@@ -41,15 +47,11 @@ class LegIk {
     const int frames = static_cast<int>(in_.target_speed.size());
     for (int b = 0; b < n_; ++b) state_.angles[b] = std::clamp(Real(0), chain_.limit_min[b], chain_.limit_max[b]);
     for (int f = 0; f < frames;) {
-      if (feet_.contact[f * kLegCount + leg_] > 0) {
-        const Vec3& goal = feet_.planned[f * kLegCount + leg_];
-        record(f, goal, state_.angles, advance(state_, local_goal(f, goal), true, f < 2, nullptr));
-        ++f;
-        continue;
-      }
+      const bool planted = feet_.contact[f * kLegCount + leg_] > 0;
       int g = f;
-      while (g < frames && feet_.contact[g * kLegCount + leg_] == 0) ++g;
-      solve_swing(f, g);
+      while (g < frames && (feet_.contact[g * kLegCount + leg_] > 0) == planted) ++g;
+      if (planted) solve_stance(f, g);
+      else solve_swing(f, g);
       f = g;
     }
   }
@@ -69,6 +71,8 @@ class LegIk {
   // One frame on from `st` for the foot at `goal2`; returns the miss. The warm start
   // is the previous frame's pose (seed 3.2) carried on by its change from the frame
   // before (a foot's angles move smoothly, so this lands close), or `seed` if given.
+  // A planted foot is solved tighter; only the bake's very first frames may restart
+  // cold (a new leg configuration), never a stance under way.
   Real advance(LegIkState& st, const Vec2d& goal2, bool planted, bool first_frames, const Real* seed) const {
     Real* angles = st.angles;
     if (goal2 == st.last_target) {  // nothing moved (standing): keep the pose exactly
@@ -82,8 +86,42 @@ class LegIk {
       st.previous[bone] = last;
     }
     const Real tolerance = planted ? kIkTolerance : kSwingIkTolerance;
-    st.last_error = solve_ccd(chain_, goal2, in_.ccd_iterations, tolerance, angles, planted).error;
-    if (!planted && !seed && !first_frames && st.last_error > kSwingTolerance) {
+    if (!first_frames && (planted || swing_dls_)) {
+      // The least change from the last pose (continuous: a planted leg never takes a new
+      // configuration, and stance and swing hand over without a kink); CCD only where
+      // that cannot reach the foot, and a cold restart only to keep a planted foot from
+      // sliding.
+      Real dls[kMaxBones];
+      std::copy(seed ? seed : st.previous, (seed ? seed : st.previous) + n_, dls);
+      const Real dls_error = solve_dls(chain_, goal2, 4 * in_.ccd_iterations, tolerance, dls).error;
+      if (dls_error <= (planted ? kStanceTolerance : 2 * kSwingIkTolerance) || (planted && seed)) {
+        std::copy(dls, dls + n_, angles);
+        st.last_error = dls_error;
+        return st.last_error;
+      }
+      if (planted) {
+        // CCD on from there; a cold restart (a new configuration) only if the foot would
+        // otherwise slide more than kStanceSlide.
+        std::copy(dls, dls + n_, angles);
+        st.last_error = solve_ccd(chain_, goal2, in_.ccd_iterations, tolerance, angles, false).error;
+        if (st.last_error > kStanceSlide) {
+          Real cold[kMaxBones];
+          std::copy(dls, dls + n_, cold);
+          const Real error = solve_ccd(chain_, goal2, in_.ccd_iterations, tolerance, cold, true).error;
+          if (error < st.last_error) {
+            std::copy(cold, cold + n_, angles);
+            st.last_error = error;
+          }
+        }
+        if (st.last_error > dls_error) {
+          std::copy(dls, dls + n_, angles);
+          st.last_error = dls_error;
+        }
+        return st.last_error;
+      }
+    }
+    st.last_error = solve_ccd(chain_, goal2, in_.ccd_iterations, tolerance, angles, planted && first_frames).error;
+    if (!seed && !first_frames && st.last_error > (planted ? kStanceTolerance : kSwingTolerance)) {
       // At lift-off the foot turns back on its root: carried on, the warm start can
       // overshoot into a limit the solve cannot leave. The plain previous pose then.
       Real plain[kMaxBones];
@@ -107,39 +145,41 @@ class LegIk {
     }
   }
 
-  // Forward from the lift-off pose, frame by frame with the warm start.
-  void forward(SwingTrack& track) const {
+  // Forward from the span's first pose (lift-off or touch-down), frame by frame with
+  // the warm start.
+  void forward(SwingTrack& track, bool planted = false) {
     track.angles.resize(static_cast<std::size_t>(count_) * n_);
     track.error.resize(count_);
     track.worst = 0;
     LegIkState st = state_;
     for (int i = 0; i < count_; ++i) {
-      track.error[i] = advance(st, goals2_[i], false, first_ + i < 2, nullptr);
+      track.error[i] = advance(st, goals2_[i], planted, first_ + i < 2, nullptr);
       track.worst = std::max(track.worst, track.error[i]);
       std::copy(st.angles, st.angles + n_, track.angles.begin() + i * n_);
     }
   }
 
-  // Backward in time from the landing pose, frame by frame with the warm start.
-  void backward(const Real* landing, SwingTrack& track) const {
+  // Backward in time from the span's last pose, frame by frame with the warm start.
+  void backward(const Real* landing, SwingTrack& track, bool planted = false) const {
     track.angles.resize(static_cast<std::size_t>(count_) * n_);
     track.error.resize(count_);
     LegIkState st;
     std::copy(landing, landing + n_, st.angles);
     std::copy(landing, landing + n_, st.previous);
     for (int i = count_ - 1; i >= 0; --i) {
-      track.error[i] = advance(st, goals2_[i], false, false, nullptr);
+      track.error[i] = advance(st, goals2_[i], planted, false, nullptr);
       std::copy(st.angles, st.angles + n_, track.angles.begin() + i * n_);
     }
   }
 
   // Where both the forward and the backward solve follow the path, crosses from one to
   // the other, each frame re-solved from a blend of the two. False if no frame has both.
-  bool cross(const SwingTrack& ahead, const SwingTrack& back, SwingTrack& crossed) const {
+  bool cross(const SwingTrack& ahead, const SwingTrack& back, SwingTrack& crossed, bool planted = false) const {
+    const Real follows = planted ? kStanceTolerance : kSwingTolerance;
     int ahead_end = 0;  // frames [0, ahead_end) follow going forward
-    while (ahead_end < count_ && ahead.error[ahead_end] <= kSwingTolerance) ++ahead_end;
+    while (ahead_end < count_ && ahead.error[ahead_end] <= follows) ++ahead_end;
     int back_start = count_;  // frames [back_start, count) follow going backward
-    while (back_start > 0 && back.error[back_start - 1] <= kSwingTolerance) --back_start;
+    while (back_start > 0 && back.error[back_start - 1] <= follows) --back_start;
     if (back_start >= ahead_end) return false;
     const int w0 = back_start, w1 = ahead_end;  // crossing window [w0, w1)
     crossed = ahead;
@@ -152,11 +192,54 @@ class LegIk {
       const Real t = std::clamp(static_cast<Real>(i - w0 + 1) / (w1 - w0 + 1), Real(0), Real(1));
       const Real w = t * t * (3 - 2 * t);
       for (int bone = 0; bone < n_; ++bone) seed[bone] = a[bone] + w * (b[bone] - a[bone]);
-      crossed.error[i] = advance(cs, goals2_[i], false, false, seed);
+      if (planted && (w <= 0 || w >= 1)) {
+        // Outside the crossing a stance keeps the solve it crosses from or to as it is.
+        const SwingTrack& from = w <= 0 ? ahead : back;
+        std::copy(cs.angles, cs.angles + n_, cs.previous);
+        std::copy(from.angles.begin() + i * n_, from.angles.begin() + (i + 1) * n_, cs.angles);
+        cs.last_target = goals2_[i];
+        cs.last_error = crossed.error[i] = from.error[i];
+      } else {
+        crossed.error[i] = advance(cs, goals2_[i], planted, false, seed);
+      }
       crossed.worst = std::max(crossed.worst, crossed.error[i]);
       std::copy(cs.angles, cs.angles + n_, crossed.angles.begin() + i * n_);
     }
     return true;
+  }
+
+  // A stance, frames [first, last), solved as a whole like a swing: forward from the
+  // touch-down pose with the warm start and no cold restart, so the leg keeps its
+  // configuration while the foot is planted. Where that cannot hold the foot within
+  // kStanceTolerance, the lift-off pose (solved with restarts) solved backwards in time
+  // gives the other branch, and the pose crosses over, blended, where both hold it;
+  // the better of the two wins.
+  void solve_stance(int first, int last) {
+    first_ = first;
+    count_ = last - first;
+    goals_.resize(count_);
+    goals2_.resize(count_);
+    set_goals(1);
+    SwingTrack best;
+    forward(best, true);
+    if (best.worst > kStanceTolerance && first_ + count_ > 2) {
+      Real lift_off[kMaxBones];
+      std::copy(best.angles.end() - n_, best.angles.end(), lift_off);
+      solve_ccd(chain_, goals2_[count_ - 1], in_.ccd_iterations, kIkTolerance, lift_off, true);
+      SwingTrack back, crossed;
+      backward(lift_off, back, true);
+      if (cross(best, back, crossed, true) && crossed.worst < best.worst) best = crossed;
+    }
+    finish_span(best);
+  }
+
+  void finish_span(const SwingTrack& best) {
+    for (int i = 0; i < count_; ++i) record(first_ + i, goals_[i], best.angles.data() + i * n_, best.error[i]);
+    // Carry the warm start on from the span's last two poses.
+    std::copy(best.angles.end() - n_, best.angles.end(), state_.angles);
+    if (count_ >= 2) std::copy(best.angles.end() - 2 * n_, best.angles.end() - n_, state_.previous);
+    state_.last_target = goals2_[count_ - 1];
+    state_.last_error = best.error[count_ - 1];
   }
 
   // A swing, frames [first, last), solved as a whole. Where the warm start does not
@@ -168,6 +251,7 @@ class LegIk {
   // else the one that follows best.
   void solve_swing(int first, int last) {
     const int frames = static_cast<int>(in_.target_speed.size());
+    swing_dls_ = true;
     first_ = first;
     count_ = last - first;
     goals_.resize(count_);
@@ -175,6 +259,12 @@ class LegIk {
     set_goals(kLiftScales[0]);
     SwingTrack best;
     forward(best);
+    if (best.worst > kSwingTolerance) {  // least change stuck on a limit: plain CCD may go round it
+      SwingTrack plain;
+      swing_dls_ = false;
+      forward(plain);
+      if (plain.worst < best.worst) best = plain;
+    }
     Real best_scale = kLiftScales[0];
     if (best.worst > kSwingTolerance) {
       Real landing[kMaxBones];
@@ -204,12 +294,7 @@ class LegIk {
       }
       set_goals(best_scale);
     }
-    for (int i = 0; i < count_; ++i) record(first_ + i, goals_[i], best.angles.data() + i * n_, best.error[i]);
-    // Carry the warm start on from the swing's last two poses.
-    std::copy(best.angles.end() - n_, best.angles.end(), state_.angles);
-    if (count_ >= 2) std::copy(best.angles.end() - 2 * n_, best.angles.end() - n_, state_.previous);
-    state_.last_target = goals2_[count_ - 1];
-    state_.last_error = best.error[count_ - 1];
+    finish_span(best);
   }
 
   const BakeInput& in_;
@@ -220,6 +305,7 @@ class LegIk {
   BakeOutput& out_;
   LegIkState state_;
   int first_ = 0, count_ = 0;  // the swing being solved
+  bool swing_dls_ = true;      // swings solved by least change first (CCD where that fails)
   std::vector<Vec3> goals_;
   std::vector<Vec2d> goals2_;
 };

@@ -14,10 +14,16 @@ constexpr int kMaxBones = 6;
 Vec3 up() { return Vec3(0, 0, 1); }
 }  // namespace
 
+namespace {
+// Grid coordinate clamped to [0, top]; NaN (a NaN origin, or inf - inf) maps to 0, so
+// the integer cast below never sees NaN or inf (undefined behaviour: a wild index).
+Real grid_coordinate(Real f, Real top) { return f > 0 ? (f < top ? f : top) : Real(0); }
+}  // namespace
+
 Real Heightfield::at(Real x, Real y) const {
-  if (empty()) return 0;
-  const Real fx = std::clamp((x - x0) / cell, Real(0), Real(nx - 1));
-  const Real fy = std::clamp((y - y0) / cell, Real(0), Real(ny - 1));
+  if (empty() || heights.size() < static_cast<std::size_t>(nx) * static_cast<std::size_t>(ny)) return 0;
+  const Real fx = grid_coordinate((x - x0) / cell, Real(nx - 1));
+  const Real fy = grid_coordinate((y - y0) / cell, Real(ny - 1));
   const int ix = std::min(nx - 2, static_cast<int>(fx)), iy = std::min(ny - 2, static_cast<int>(fy));
   const Real wx = fx - ix, wy = fy - iy;
   auto h = [&](int i, int j) { return heights[static_cast<std::size_t>(j) * nx + i]; };

@@ -48,7 +48,7 @@ FinPose fin_axis(const Vec3List& rest, const RootFrame& frame, const FinWave& wa
   }
 
   // The outer points turn about the last fixed one (the hinge); the fixed points
-  // clustered at the root keep the fin attached (SEEDS §1).
+  // clustered at the root keep the fin attached (docs/algorithms.md §2.4).
   const std::size_t fixed = std::clamp<std::size_t>(std::size_t(std::max(wave.fixed_count, 1)), 1, m - 1);
   const Vec3 hinge = rest[fixed - 1];
   Mat3 rotation = Mat3::Identity();
@@ -58,7 +58,7 @@ FinPose fin_axis(const Vec3List& rest, const RootFrame& frame, const FinWave& wa
       // Tip moves fore/aft; a fin lying along the body (caudal) moves sideways.
       const Vec3 k = cross_or(axis, frame.tangent, frame.up);
       rotation = axis_rotation(k, wave.amplitude * std::sin(phase));
-      // Feathering (SEEDS §1): blade across the motion on the power stroke (tip moving
+      // Feathering (docs/algorithms.md §2.4): blade across the motion on the power stroke (tip moving
       // tailward, cos φ > 0), nearly edge-on on the recovery. The roll sits on whichever
       // stroke the modelled blade does not already match.
       const Real toward = wave.feather_on_power ? Real(1) + std::cos(phase) : Real(1) - std::cos(phase);

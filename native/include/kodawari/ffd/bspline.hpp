@@ -1,5 +1,5 @@
 // Clamped uniform cubic B-spline: the control curve M(t), t in [0, 1], of the
-// control-axis FFD (SEEDS §1). The curve starts at the first control point and
+// control-axis FFD (docs/algorithms.md §1.1). The curve starts at the first control point and
 // ends at the last; interior knots are evenly spaced.
 #pragma once
 

@@ -1,4 +1,4 @@
-// Closest curve point to a vertex, for the bind step (SEEDS §1 step 1): a coarse
+// Closest curve point to a vertex, for the bind step (docs/algorithms.md §1.3): a coarse
 // polyline search picks the basin, then Newton on the exact spline refines t.
 #pragma once
 

@@ -1,4 +1,4 @@
-// The control-axis FFD (SEEDS §1, Yamanogue's axial deformation): bind a mesh to
+// The control-axis FFD (docs/algorithms.md §1, Yamanogue's axial deformation): bind a mesh to
 // a control curve once, then rebuild it from any new pose of the curve.
 #pragma once
 

@@ -46,7 +46,7 @@ inline TableFrame table_frame(const TableSegment& s, float f) {
   return {s.origin + f * s.d_origin, s.e1 + f * s.d_e1, s.e2 + f * s.d_e2, s.e3 + f * s.d_e3};
 }
 
-// P' = M(t) + u e2 + v e3 + w e1 (SEEDS §1 eq. 3.2, plus w beyond the ends),
+// P' = M(t) + u e2 + v e3 + w e1 (docs/algorithms.md §1.4, plus w beyond the ends),
 // with the frame interpolated linearly within the segment. Four-lane float
 // arithmetic, the same for every vertex whichever thread computes it.
 inline void deform_vertex(const TableSegment& s, const AxisCoordinate& c, float* out) {

@@ -1,4 +1,4 @@
-// Frames Σ(M(t); e1, e2, e3) along the control curve (SEEDS §1, the "sub-axis").
+// Frames Σ(M(t); e1, e2, e3) along the control curve (docs/algorithms.md §1.2, the "sub-axis").
 // e1 is the unit tangent; (e2, e3) come from the rotation-minimising frame
 // computed by double reflection (Wang, Jüttler, Zheng, Liu, ACM TOG 27(1), 2008,
 // Algorithm "double reflection"), then rolled about e1 by the twist that the

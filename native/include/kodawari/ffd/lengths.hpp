@@ -1,5 +1,5 @@
-// Keeping control-point distances so the body does not stretch (SEEDS §1,
-// "Keeping control-point distances"), and the rest lengths they keep.
+// Keeping control-point distances so the body does not stretch (docs/algorithms.md
+// §1.5), and the rest lengths they keep.
 #pragma once
 
 #include <optional>

@@ -48,6 +48,14 @@ struct CcdResult {
 CcdResult solve_ccd(const LegChain& chain, const Vec2& target, int iterations, Real tolerance, Real* angles,
                     bool allow_restart = true);
 
+// Damped least squares for a planted foot (docs/algorithms.md §4.8; Wampler
+// 1986, Nakamura & Hanafusa 1986): from the previous pose, Gauss-Newton steps with the
+// joints weighted by their stiffness, dtheta = S J^T (J S J^T + lambda^2 I)^-1 e. Each
+// step is the least weighted change that moves the foot towards the target, so the
+// pose follows a moving target continuously: it never jumps to another leg
+// configuration the way a CCD sweep can. A joint that reaches a limit is held there.
+CcdResult solve_dls(const LegChain& chain, const Vec2& target, int iterations, Real tolerance, Real* angles);
+
 // How far the chain reaches from its root along `direction` (unit, (f, u)) within its
 // limits: the foot's distance along the direction after solving towards a far target.
 Real directional_reach(const LegChain& chain, const Vec2& direction);

@@ -19,7 +19,8 @@ constexpr int kLegCount = 4;
 inline bool is_fore(int leg) { return leg == kLF || leg == kRF; }
 
 struct GaitParams {
-  Real duty_factor = 0.5;       // alpha: stance time / cycle time
+  Real duty_factor = 0.5;       // alpha: stance time / cycle time (at the bottom of the band)
+  Real duty_factor_top = 0.5;   // alpha at the top of the band: falls with speed in the gallop
   Real phase_fore_hind = 0.5;   // D1 (seed 3.3): LF lifts off D1 of a cycle after LH
   Real phase_left_right = 0.5;  // D2: RH lifts off D2 after LH
   Real swing_time = 0.3;        // P, seconds (constant per animal, seed 2.2)
@@ -40,12 +41,45 @@ struct GaitTable {
                             // (horse: 0.8 m for a 1.6 m leg, seed 4.3)
 };
 
+constexpr const char* kGaitNames[kGaitCount] = {"WALK", "TROT", "CANTER", "GALLOP", "GALLOP_ROTARY"};
+constexpr const char* kLegNames[kLegCount] = {"LF", "RF", "LH", "RH"};
+
+// Hip height (m) of the horse the default table is tuned on: the sample Thoroughbred
+// (1.406 m; Blender's Rigify horse metarig stands 1.408 m at the hip).
+constexpr Real kHorseLegLength = 1.406;
+
+// The table for an animal whose hip stands `leg_length` m high, by dynamic similarity
+// (Alexander & Jayes 1983; docs/algorithms.md §4.2): at equal Froude number
+// v^2/(g L) animals use the same duty factors and phases, strides scale with L, so
+// speeds scale with sqrt(L / L0), times with sqrt(L / L0), heights with L / L0.
+// Froude band tops are dimensionless and stay.
+GaitTable scale_table(const GaitTable& table, Real leg_length, Real reference = kHorseLegLength);
+
 // The horse defaults: the seed's table, with the canter and gallop tuned to the
 // literature notes (see gait_table.cpp for the numbers and why).
 GaitTable horse_gait_table();
 
 // Cycle time T = P / (1 - alpha)  (seed 3.2).
 Real cycle_time(const GaitParams& params);
+Real cycle_time(Real swing_time, Real duty_factor);
+
+// Bottom of a gait's band in m/s: the highest AUTO band top below its own top (0 for the first).
+Real band_bottom(const GaitTable& table, Gait gait, Real leg_length);
+
+// The duty factor at `speed`: duty_factor at the bottom of the band, duty_factor_top at
+// its top, and in between the one that keeps the stance length (distance travelled
+// over a planted foot) interpolated linearly, clamped outside. Gallops use it: the
+// stance shortens with speed, so the stride at low gallop speed is longer than a fixed
+// alpha gives (Thoroughbreds: alpha ~0.32 at 9 m/s, ~0.2 at 17 m/s).
+Real duty_at(const GaitTable& table, Gait gait, Real speed, Real leg_length);
+
+// The speed-range rule: the first frame whose speed is past the range of its gait mode
+// (-1 AUTO: the table's top), or -1 when every frame is within range.
+struct SpeedProblem {
+  int frame = -1;
+  Real top = 0;
+};
+SpeedProblem check_speeds(const GaitTable& table, const Real* speed, const int* mode, int frames, Real leg_length);
 
 // Lift-off phase of `leg` in the cycle, relative to LH (seed: LH 0, LF D1, RH D2,
 // RF D1 + D2; the rotary gallop swaps the fore pair: RF D1, LF D1 + D2). In [0, 1).

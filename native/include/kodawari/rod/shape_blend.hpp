@@ -1,5 +1,5 @@
-// Chain shapes as per-joint rotations with fixed lengths (SEEDS.md section 2,
-// "Chain shape and its interpolation"). A shape holds, for every bone, its
+// Chain shapes as per-joint rotations with fixed lengths (docs/algorithms.md
+// §3.1). A shape holds, for every bone, its
 // rotation relative to its rest frame in the parent bone (Blender's pose-bone
 // `rotation_quaternion`), so blending never changes a bone's length; positions come
 // back by forward kinematics from the chain root.

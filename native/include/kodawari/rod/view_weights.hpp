@@ -1,5 +1,5 @@
 // Blend weights of keyed shapes from how similar the current condition is to
-// each key (SEEDS.md section 2, "View direction and weights"):
+// each key (docs/algorithms.md §3.2):
 //   w_i = s_i ^ p_i,  s = sum w_i,  if s >= 1: w_i /= s,  w_0 = 1 - min(s, 1)
 // where s_i in [0, 1] is the similarity of key i (1 = exactly the keyed condition)
 // and p_i > 0 its influence. The three conditions differ only in the similarity.

@@ -1,6 +1,6 @@
-// The fish body wave (SEEDS §1 "Body"): a sine wave travels head→tail along the
+// The fish body wave (docs/algorithms.md §2.1): a sine wave travels head→tail along the
 // control axis and its amplitude grows toward the tail. Stateless: the caller
-// passes the ACCUMULATED phase (φ += ω·dt, SEEDS literature notes), never ω·t,
+// passes the ACCUMULATED phase (φ += ω·dt, docs/algorithms.md §2.2), never ω·t,
 // so an animated frequency never makes the wave jump.
 #pragma once
 
@@ -17,7 +17,7 @@ struct BodyWave {
   Real envelope_start = 0.0;   // fraction of the body (from the snout) where growth begins
   Real envelope_power = 1.0;   // shape of the growth from envelope_start to the tail
   Real phase_offset = 0.0;     // radians, added to the accumulated phase
-  bool preserve_length = true; // keep control-point distances (SEEDS §1)
+  bool preserve_length = true; // keep control-point distances (docs/algorithms.md §2.3)
 };
 
 // Peak amplitude (fraction of body length) at body fraction s in [0, 1].

@@ -1,4 +1,4 @@
-// Automatic fin finder (docs/algorithms.md, "Fish: finding fins"): fins are the
+// Automatic fin finder (docs/algorithms.md §2.8): fins are the
 // parts of a fish mesh that stand out of the body's cross-section.
 //
 // Each vertex is placed in the cross-section of the body axis nearest to it

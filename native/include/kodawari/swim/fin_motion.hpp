@@ -1,4 +1,4 @@
-// Fin axis motion (SEEDS §1 "Fins"): a small control axis per fin, root first,
+// Fin axis motion (docs/algorithms.md §2.4): a small control axis per fin, root first,
 // whose first points are clustered at the root and stay fixed (so the fin never
 // tears from the body) while the outer points rotate about the root.
 #pragma once

@@ -1,4 +1,4 @@
-// One fin part bound for motion (docs/algorithms.md, "Fish: fins"). Replaces a
+// One fin part bound for motion (docs/algorithms.md §2.4). Replaces a
 // per-fin FFD: every fin vertex swings as if hinged at its OWN root point (the
 // lever is its reach across the fin, along the fin's outward direction),
 // with the motion's angle faded in by a weight that rises from 0 on the body to 1

@@ -1,4 +1,4 @@
-// How far each fin vertex stands from the body (docs/algorithms.md, "Fish: fins"):
+// How far each fin vertex stands from the body (docs/algorithms.md §2.4):
 // the distance to the nearest body vertex, which is 0 on the fin's root row and
 // grows toward its rim. The fin motion fades in over it, so the root stays on the body.
 #pragma once

@@ -1,4 +1,4 @@
-// How fast a fish swims for its tail beat (docs/algorithms.md, "Fish: speed").
+// How fast a fish swims for its tail beat (docs/algorithms.md §2.6).
 #pragma once
 
 #include "kodawari/common.hpp"

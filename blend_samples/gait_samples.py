@@ -150,3 +150,75 @@ def key_speed(obj, frames_and_speeds):
     for frame, speed in frames_and_speeds:
         settings.speed = speed
         obj.keyframe_insert(data_path="kodawari_gait.speed", frame=frame)
+
+
+def rigify_metarig(scene, animal):
+    """Blender's bundled Rigify animal metarig ("wolf", "horse", "cat"), built by Rigify's
+    own metarig script (Rigify ships with Blender as an add-on; it is enabled here)."""
+    import importlib
+
+    import addon_utils
+
+    addon_utils.enable("rigify", default_set=True)
+    module = importlib.import_module(f"rigify.metarigs.Animals.{animal}")
+    armature = bpy.data.armatures.new(f"{animal}_metarig")
+    obj = bpy.data.objects.new(f"{animal.capitalize()}Metarig", armature)
+    scene.collection.objects.link(obj)
+    previous = bpy.context.view_layer.objects.active
+    bpy.context.view_layer.objects.active = obj
+    module.create(obj)
+    bpy.ops.object.mode_set(mode="OBJECT")
+    bpy.context.view_layer.objects.active = previous
+    return obj
+
+
+def skin_armature(rig, scene, bone_names, radius):
+    """A simple skinned body for an armature: a Skin-modifier mesh with a vertex at each
+    listed bone's head and tail, edges along the bones, each vertex weighted fully to its
+    bone; radii taper from `radius` on the trunk to a third of it at the feet."""
+    bones = rig.data.bones
+    wanted = [b for b in bones if b.name in bone_names]
+    verts, groups, radii, edges = [], [], [], []
+    at = {}
+
+    def vertex(p, group, r):
+        key = tuple(round(c, 4) for c in p)
+        if key in at:
+            return at[key]
+        verts.append(tuple(p))
+        groups.append(group)
+        radii.append(r)
+        at[key] = len(verts) - 1
+        return at[key]
+
+    lowest = min(b.tail_local.z for b in wanted)
+    highest = max(b.head_local.z for b in wanted)
+    for b in wanted:
+        def r_at(z):
+            return radius * (0.3 + 0.7 * min(1.0, max(0.0, (z - lowest) / max(highest - lowest, 1e-6))) ** 2)
+        a = vertex(b.head_local, b.name, r_at(b.head_local.z))
+        c = vertex(b.tail_local, b.name, r_at(b.tail_local.z))
+        if a != c:
+            edges.append((a, c))
+        if b.parent is not None and b.parent.name in bone_names and not b.use_connect:
+            # join an unconnected child to the nearest end of its parent
+            p = b.parent
+            near = min((p.head_local, p.tail_local), key=lambda q: (q - b.head_local).length)
+            edges.append((vertex(near, p.name, r_at(near.z)), a))
+    mesh = bpy.data.meshes.new(rig.name + "Skin")
+    mesh.from_pydata(verts, sorted(set(tuple(sorted(e)) for e in edges if e[0] != e[1])), [])
+    body = bpy.data.objects.new(rig.name + "Body", mesh)
+    scene.collection.objects.link(body)
+    body.parent = rig
+    for name in dict.fromkeys(groups):
+        group = body.vertex_groups.new(name=name)
+        group.add([i for i, g in enumerate(groups) if g == name], 1.0, "REPLACE")
+    body.modifiers.new("Armature", "ARMATURE").object = rig
+    skin = body.modifiers.new("Skin", "SKIN")
+    skin.use_smooth_shade = True
+    for i, r in enumerate(radii):
+        mesh.skin_vertices[0].data[i].radius = (r, r)
+    mesh.skin_vertices[0].data[0].use_root = True
+    sub = body.modifiers.new("Subdivision", "SUBSURF")
+    sub.levels, sub.render_levels = 1, 2
+    return body

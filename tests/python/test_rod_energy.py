@@ -1,0 +1,79 @@
+"""Long strands lose energy and come to rest (issue 9 item 1).
+
+The old length pass moved each joint onto its parent's sphere, root to tip, and took the
+velocity from that move: every correction reached the tip as speed, and strands of ten or
+more bones kept whipping at metres per second. The solver now projects lengths with both
+ends of every segment moving (rod/inextensibility.hpp)."""
+
+import numpy as np
+import pytest
+from rod_chain import Chain
+
+GRAVITY = 9.81
+STRAND_LENGTH = 0.6
+
+
+def strand(bones, **params):
+    """A 0.6 m strand sticking out horizontally from the head (its rest shape): gravity
+    bends it down from the first frame."""
+    chain = Chain(bones=bones, length=STRAND_LENGTH / bones, root_offset=(0.0, 0.05, 0.0), **params)
+    chain.reset()
+    return chain
+
+
+def kinetic_and_gravitational(chain):
+    x = chain.positions()[1:]  # joints after the kinematic root, unit mass each
+    v = chain.system.joint_velocities(chain.rod)[1:]
+    return 0.5 * float(np.sum(v * v)) + GRAVITY * float(np.sum(x[:, 2]))
+
+
+# Heavy damping on long strands still gains a little (measured: 0.002 J at 32 bones,
+# 0.33 J and 1.24 J at 64, against 70-190 J lost): not solved yet, shown as such.
+STILL_GAINS = pytest.mark.xfail(
+    strict=True, reason="heavy damping on long strands still gains energy"
+)
+CASES = [
+    pytest.param(
+        bones,
+        damping,
+        substeps,
+        marks=STILL_GAINS
+        if (bones, damping, substeps) in {(32, 20.0, 1), (64, 20.0, 1), (64, 20.0, 4)}
+        else (),
+    )
+    for bones in (16, 32, 64)
+    for damping in (0.0, 20.0)
+    for substeps in (1, 4)
+]
+
+
+@pytest.mark.parametrize(("bones", "damping", "substeps"), CASES)
+def test_a_strand_without_bending_stiffness_never_gains_energy(bones, damping, substeps):
+    # With (almost) no bending stiffness to store energy, kinetic + gravitational energy is
+    # all there is: it may only fall, with or without damping (the UI's extremes 0 and 20 1/s),
+    # at the fewest and the default substeps. The old solver gained 292 J in one frame at 16
+    # bones, 4871 J at 64.
+    chain = strand(bones, stiffness=0.01, damping=damping, substeps=substeps)
+    energy = [kinetic_and_gravitational(chain)]
+    for _ in range(96):
+        chain.step()
+        energy.append(kinetic_and_gravitational(chain))
+    gains = np.diff(energy)
+    assert gains.max() <= 0.0, f"energy grew by {gains.max():.4g} J in one frame"
+    lengths = np.linalg.norm(np.diff(chain.positions(), axis=0), axis=1)
+    np.testing.assert_allclose(lengths, STRAND_LENGTH / bones, rtol=1e-5)
+
+
+@pytest.mark.parametrize("bones", [2, 4, 8, 12, 16, 24, 32, 48, 64])
+def test_every_strand_at_the_defaults_comes_to_rest_from_a_horizontal_start(bones):
+    # Defaults: stiffness 0.5, damping 1/s, 4 substeps, 1 iteration. Damping 1/s halves a
+    # swing's amplitude every 1.4 s: a tip whipping at 5-6 m/s stays below 1 cm/s from 9.7 s
+    # on (measured, 24-64 bones); the old solver kept 64-bone tips at 8-20 m/s indefinitely.
+    chain = strand(bones)
+    tip_speeds = []
+    for _ in range(24 * 12):
+        chain.step()
+        tip_speeds.append(np.linalg.norm(chain.system.joint_velocities(chain.rod)[-1]))
+    settled = np.array(tip_speeds[24 * 10 :])
+    assert settled.max() < 0.01, f"tip still moves at {settled.max():.3f} m/s after 10 s"
+    assert max(tip_speeds) > 0.2, "the strand should swing down first"
