@@ -1,8 +1,5 @@
 """Operators: add / remove the swim, add / find fins, flip the head, bake."""
 
-# bl_options sets are Blender's class-attribute convention, never mutated.
-# ruff: noqa: RUF012
-
 import types
 
 import bpy
@@ -41,7 +38,9 @@ class KODAWARI_OT_swim_add(bpy.types.Operator):
         description="Which way the head points (Auto: guessed from the shape)",
     )
     preset: EnumProperty(
-        name="Preset", items=[(k, *presets.LABELS[k]) for k in presets.ORDER], default="CARANGIFORM",
+        name="Preset",
+        items=[(k, *presets.LABELS[k]) for k in presets.ORDER],
+        default="CARANGIFORM",
         description="A kind of swimmer: sets the body wave and the fins' motions",
     )
     frequency: FloatProperty(
@@ -243,7 +242,9 @@ class KODAWARI_OT_swim_fin_add(bpy.types.Operator):
     bl_options = {"REGISTER", "UNDO"}
 
     vertex_group: StringProperty(name="Vertex Group", description="The fin's vertices")
-    kind: EnumProperty(name="Kind", items=_fin_kind_items(), default="PECTORAL", description="Which fin this is")
+    kind: EnumProperty(
+        name="Kind", items=_fin_kind_items(), default="PECTORAL", description="Which fin this is"
+    )
 
     def invoke(self, context, event):
         obj = _active_mesh(context)
@@ -326,7 +327,7 @@ class KODAWARI_OT_swim_fin_find(bpy.types.Operator):
         added = []
         known = {}
         count = len(obj.data.vertices)
-        for name, kind, indices in found:
+        for name, _kind, indices in found:
             group = obj.vertex_groups.get(name)
             if group is not None:  # a search run again replaces what it found before
                 obj.vertex_groups.remove(group)

@@ -86,8 +86,12 @@ class KodawariSwimFin(bpy.types.PropertyGroup):
         update=_rebind,
         description="How the fin moves",
     )
-    enabled: BoolProperty(name="Enabled", default=True, update=_refresh,
-                          description="Move this fin (off: it follows the body only)")
+    enabled: BoolProperty(
+        name="Enabled",
+        default=True,
+        update=_refresh,
+        description="Move this fin (off: it follows the body only)",
+    )
     amplitude: FloatProperty(
         name="Amplitude",
         description="How far the fin swings to each side. Undulate: the sideways reach as a share of the fin's height (1 rad = 1 height)",
@@ -297,7 +301,9 @@ class KodawariSwimSettings(bpy.types.PropertyGroup):
         subtype="FACTOR",
         update=_refresh,
     )
-    fins: CollectionProperty(type=KodawariSwimFin, name="Fins", description="The fins that move on their own")
+    fins: CollectionProperty(
+        type=KodawariSwimFin, name="Fins", description="The fins that move on their own"
+    )
     fin_index: IntProperty(name="Active Fin", default=0, description="The fin shown below the list")
     show_axis: BoolProperty(
         name="Show Axis", description="Draw the control axis in the viewport", default=True
@@ -308,8 +314,10 @@ class KodawariSwimSettings(bpy.types.PropertyGroup):
         name="Head Guess", description="Which way Add Fish Swim guessed the head points, and why"
     )
     rest_delta_location: FloatVectorProperty(
-        name="Rest Delta Location", size=3, subtype="TRANSLATION",
-        description="Where the fish was before it swam off (restored when the swim is removed)"
+        name="Rest Delta Location",
+        size=3,
+        subtype="TRANSLATION",
+        description="Where the fish was before it swam off (restored when the swim is removed)",
     )
     baked: EnumProperty(
         name="Baked",
@@ -322,6 +330,8 @@ class KodawariSwimSettings(bpy.types.PropertyGroup):
         description="Whether the swim is live or baked, and to what",
     )
     cache_path: StringProperty(
-        name="Cache Path", subtype="FILE_PATH", options=cache_paths.RELATIVE_PATH_OPTIONS,
+        name="Cache Path",
+        subtype="FILE_PATH",
+        options=cache_paths.RELATIVE_PATH_OPTIONS,
         description="The baked point cache file",
     )
