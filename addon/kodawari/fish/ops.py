@@ -176,9 +176,10 @@ def _fin_kind_items():
     return [(k, k.title(), f"{k.title()} fin") for k in presets.FIN_KINDS]
 
 
-def _check_fin(obj, group_name, kind, known_weights=None):
+def _check_fin(obj, group_name, kind, known_weights=None, reach=None):
     """(error, None) or (None, weights) for a new fin, validated by binding it on trial.
-    known_weights: {group: weights} already in hand (Find Fins), read from the mesh otherwise."""
+    known_weights: {group: weights} already in hand (Find Fins), read from the mesh
+    otherwise; reach: fin_setup.fin_reach over every fin, when already computed."""
     known_weights = known_weights or {}
     error, weights = validate.fin_group(
         obj, group_name, obj.kodawari_swim.fins, known_weights.get(group_name)
@@ -192,16 +193,17 @@ def _check_fin(obj, group_name, kind, known_weights=None):
     )
     try:
         rig = runtime.body_rig(obj)
-        in_fin = weights > 0
-        for fin in settings.fins:
-            other = known_weights.get(fin.vertex_group)
-            if other is None:
-                other = bulk.vertex_group_weights(obj, fin.vertex_group)
-            in_fin |= other > 0
         kn = native.module()
-        reach = fin_setup.fin_reach(
-            rig.rest, finder.mesh_edges(obj.data), in_fin, rig.body_length, kn
-        )
+        if reach is None:
+            in_fin = weights > 0
+            for fin in settings.fins:
+                other = known_weights.get(fin.vertex_group)
+                if other is None:
+                    other = bulk.vertex_group_weights(obj, fin.vertex_group)
+                in_fin |= other > 0
+            reach = fin_setup.fin_reach(
+                rig.rest, finder.mesh_edges(obj.data), in_fin, rig.body_length, kn
+            )
         fin_setup.build_parts(0, trial, weights, rig.rest, rig.axis_rest, rig.up, kn, reach)
     except ValueError as exc:
         return f"Cannot bind fin '{group_name}': {exc}", None
@@ -334,11 +336,22 @@ class KODAWARI_OT_swim_fin_find(bpy.types.Operator):
             obj.vertex_groups.new(name=name).add(indices.tolist(), 1.0, "REPLACE")
             known[name] = np.zeros(count, dtype=np.float32)
             known[name][indices] = 1.0
-        # The groups' weights are known: bind once at the end, never re-read per vertex.
+        # The groups' weights are known: bind once at the end, never re-read per vertex;
+        # every fin's reach across itself comes from one pass over all of them.
+        rig = runtime.body_rig(obj)
+        in_fin = np.zeros(count, dtype=bool)
+        for weights in known.values():
+            in_fin |= weights > 0
+        for fin in obj.kodawari_swim.fins:
+            if fin.vertex_group not in known:
+                in_fin |= bulk.vertex_group_weights(obj, fin.vertex_group) > 0
+        reach = fin_setup.fin_reach(
+            rig.rest, self._search.edges, in_fin, rig.body_length, native.module()
+        )
         with runtime.batch(obj):
             for name, kind, indices in found:
                 if not any(f.vertex_group == name for f in obj.kodawari_swim.fins):
-                    error, _ = _check_fin(obj, name, kind, known)
+                    error, _ = _check_fin(obj, name, kind, known, reach)
                     if error is None:
                         add_fin(obj, name, kind, rebind=False)
                 added.append(f"{name} ({len(indices)} vertices)")

@@ -145,8 +145,13 @@ def refresh(obj):
 
 
 def rebind(obj, known_weights=None):
+    if _key(obj) in _batch_depth:
+        # Several settings change together (Find Fins adds fins one by one): the rig's
+        # signature tells get_rig to rebuild once they are done; body_rig keeps serving
+        # the rest shape meanwhile instead of rebuilding it per fin.
+        return
     forget(obj)
-    if known_weights and _key(obj) not in _batch_depth and is_live(obj):
+    if known_weights and is_live(obj):
         get_rig(obj, known_weights=known_weights)
     refresh(obj)
 
