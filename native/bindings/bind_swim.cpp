@@ -173,7 +173,8 @@ void bind_swim(py::module_& m) {
         return speed;
       },
       py::arg("mode"), py::arg("body_length"), py::arg("frequency"), py::arg("amplitude"), py::arg("strouhal"),
-      "Swimming speed (length units per second): BAINBRIDGE V = L(3f - 4)/4 held to Strouhal 0.2-0.4, "
+      "Swimming speed (length units per second): BAINBRIDGE V = L(3f - 4)/4 where it gives Strouhal 0.2-0.4 "
+      "(else the STROUHAL speed), "
       "STROUHAL U = f·A/St with A = 2·amplitude·L, NONE 0; with amplitude 0 (a fin swimmer) 0.5·L·f.");
 
   m.def("swim_bainbridge_applies", &swim::bainbridge_applies, py::arg("frequency"),

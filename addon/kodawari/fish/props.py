@@ -267,8 +267,9 @@ class KodawariSwimSettings(bpy.types.PropertyGroup):
                 "BAINBRIDGE",
                 "From Tail Beat",
                 (
-                    "Faster with a faster tail beat, as measured on real fish (Bainbridge 1958: V = L(3f - 4)/4, fitted above about 5 Hz; elsewhere held to Strouhal 0.2-0.4). "
-                    "Fin swimmers: half a body length per fin beat"
+                    "Faster with a faster tail beat, as measured on real fish (Bainbridge 1958: "
+                    "V = L(3f - 4)/4, fitted above about 5 Hz; where it leaves Strouhal 0.2-0.4, "
+                    "the Strouhal speed). Fin swimmers: half a body length per fin beat"
                 ),
             ),
             (

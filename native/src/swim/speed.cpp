@@ -28,10 +28,11 @@ Real swim_speed(SpeedMode mode, Real body_length, Real frequency, Real amplitude
     case SpeedMode::Bainbridge: {
       // Bainbridge's line was fitted to fish beating above ~5 Hz; wherever it leaves the
       // Strouhal band fish swim in (0.2-0.4, Taylor et al. 2003) — below that, or for a
-      // small tail beat — the speed is held at the band's edge.
+      // small tail beat — the Strouhal model with the object's own number takes over.
       const Real fastest = strouhal_speed(frequency, peak_to_peak, kStrouhalLow);
       const Real slowest = strouhal_speed(frequency, peak_to_peak, kStrouhalHigh);
-      return std::clamp(bainbridge_speed(body_length, frequency), slowest, fastest);
+      const Real line = bainbridge_speed(body_length, frequency);
+      return line >= slowest && line <= fastest ? line : strouhal_speed(frequency, peak_to_peak, strouhal);
     }
     case SpeedMode::Strouhal:
       return strouhal_speed(frequency, peak_to_peak, strouhal);

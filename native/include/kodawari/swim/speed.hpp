@@ -32,7 +32,8 @@ Real fin_cruise_speed(Real body_length, Real frequency);
 
 // Speed for a mode; amplitude is the tail-tip PEAK amplitude as a fraction of body
 // length. With no body wave (amplitude 0: a fin swimmer) every mode gives the fin
-// cruise speed; BAINBRIDGE is held to the Strouhal band 0.2-0.4 where its line leaves it.
+// cruise speed; where BAINBRIDGE's line leaves the Strouhal band 0.2-0.4 it gives the
+// STROUHAL speed for the object's own Strouhal number.
 Real swim_speed(SpeedMode mode, Real body_length, Real frequency, Real amplitude, Real strouhal);
 
 }  // namespace kodawari::swim
