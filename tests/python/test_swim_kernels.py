@@ -223,3 +223,53 @@ def test_fin_part_swings_each_vertex_about_its_own_root():
         np.linalg.norm(rows[:, :, :] - rows[:1, :, :], axis=2)[:, 0], heights[::5], atol=1e-6
     )
     assert np.abs(out[:5]).max() == 0.0  # the root row stays on the body
+
+
+# Each preset's body wave (wavelength, tail and snout amplitude, envelope start and power).
+PRESET_WAVES = {
+    "ANGUILLIFORM": (0.6, 0.05, 0.025, 0.0, 1.0),
+    "CARANGIFORM": (1.0, 0.06, 0.006, 0.45, 1.6),
+    "THUNNIFORM": (1.25, 0.055, 0.003, 0.6, 2.2),
+    "CETACEAN": (1.25, 0.06, 0.006, 0.5, 2.0),
+}
+
+
+@pytest.mark.parametrize(
+    "preset,points",
+    [("ANGUILLIFORM", n) for n in (16, 24)]
+    + [(p, n) for p in ("CARANGIFORM", "THUNNIFORM", "CETACEAN") for n in (8, 12, 16, 24)],
+)
+def test_body_curve_wavelength_within_five_percent_of_the_setting(preset, points):
+    """The wavelength the mesh follows: the phase slope of the fundamental, along the
+    body, of points fixed on the B-spline curve (where the FFD binds vertices), fitted
+    where the wave is at least a third of its largest amplitude."""
+    wavelength, amplitude, head, start, power = PRESET_WAVES[preset]
+    rest = np.ascontiguousarray(
+        np.stack([np.linspace(0.5, -0.5, points), np.zeros(points), np.zeros(points)], axis=1)
+    )
+    t = np.linspace(0.0, 1.0, 200)
+    s = 0.5 - kn.curve_points(rest, t)[:, 0]
+    offsets = np.array(
+        [
+            kn.curve_points(
+                kn.swim_body_axis(
+                    rest,
+                    LATERAL,
+                    1.0,
+                    2 * math.pi * k / 24,
+                    wavelength=wavelength,
+                    amplitude=amplitude,
+                    amplitude_head=head,
+                    envelope_start=start,
+                    envelope_power=power,
+                ),
+                t,
+            )[:, 1]
+            for k in range(24)
+        ]
+    )
+    spectrum = np.fft.rfft(offsets, axis=0)[1]
+    used = np.abs(spectrum) > np.abs(spectrum).max() / 3
+    slope = np.polyfit(s[used], np.unwrap(np.angle(spectrum))[used], 1)[0]
+    measured = 2 * math.pi / abs(slope)
+    assert abs(measured / wavelength - 1) <= 0.05, (measured, wavelength)
