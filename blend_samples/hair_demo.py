@@ -17,10 +17,9 @@ import subprocess
 
 import bpy
 import numpy as np
-from mathutils import Matrix, Quaternion, Vector
-
 from kodawari import fcurves
 from kodawari.hair import chains
+from mathutils import Matrix, Quaternion, Vector
 
 OUT = os.environ.get("KODAWARI_OUT", os.path.join(os.getcwd(), "out"))
 TILE = (480, 270)
@@ -80,7 +79,9 @@ def cylinder(name, length, radius, mat, collection):
 
 
 def sphere(name, location, radius, mat, collection):
-    bpy.ops.mesh.primitive_uv_sphere_add(radius=radius, location=location, segments=24, ring_count=12)
+    bpy.ops.mesh.primitive_uv_sphere_add(
+        radius=radius, location=location, segments=24, ring_count=12
+    )
     obj = bpy.context.active_object
     obj.name = name
     obj.data.materials.append(mat)
@@ -117,7 +118,13 @@ def build_character(label, mats):
     # Body: head, eyes and a neck; hair as thin cylinders on the bones.
     head_mesh = sphere(f"{label}Head", HEAD_CENTRE, HEAD_RADIUS, mats["skin"], collection)
     for side in (-1, 1):
-        eye = sphere(f"{label}Eye", HEAD_CENTRE + Vector((0.075 * side, -0.19, 0.0)), 0.045, mats["eye"], collection)
+        eye = sphere(
+            f"{label}Eye",
+            HEAD_CENTRE + Vector((0.075 * side, -0.19, 0.0)),
+            0.045,
+            mats["eye"],
+            collection,
+        )
         parent_to_bone(eye, rig, "Head")
     parent_to_bone(head_mesh, rig, "Head")
     neck = cylinder(f"{label}Neck", 0.35, 0.07, mats["skin"], collection)
@@ -138,12 +145,17 @@ def add_rods(rig):
         chains.set_selected(pb, pb.name.endswith(".0"))
     assert bpy.ops.kodawari.rod_add() == {"FINISHED"}
     for rod in rig.kodawari_hair.rods:
-        rod.stiffness = 0.9 if rod.root_bone.startswith("Ear") else (0.35 if rod.root_bone.startswith("Tail") else 0.6)
+        rod.stiffness = (
+            0.9
+            if rod.root_bone.startswith("Ear")
+            else (0.35 if rod.root_bone.startswith("Tail") else 0.6)
+        )
         rod.iterations = 6
         rod.damping = 1.5
         rod.radius = 0.012
-    assert bpy.ops.kodawari.rod_collider_add(bone="Head", shape="SPHERE", radius=HEAD_RADIUS,
-                                             offset=(0.0, 0.25, 0.0)) == {"FINISHED"}
+    assert bpy.ops.kodawari.rod_collider_add(
+        bone="Head", shape="SPHERE", radius=HEAD_RADIUS, offset=(0.0, 0.25, 0.0)
+    ) == {"FINISHED"}
 
 
 def curl(rig, name, axis_world, degrees):
@@ -179,18 +191,24 @@ def key_views(rig, scene):
         bpy.context.view_layer.update()
         reset_pose(rig)
         curl(rig, "Ahoge", ahoge_axis[view], 32)
-        assert bpy.ops.kodawari.rod_key_view(source="CAMERA", rod_index=rods["Ahoge"]) == {"FINISHED"}
+        assert bpy.ops.kodawari.rod_key_view(source="CAMERA", rod_index=rods["Ahoge"]) == {
+            "FINISHED"
+        }
         if view in ears:
             for name, axis, degrees in ears[view]:
                 curl(rig, name, axis, degrees)
-                assert bpy.ops.kodawari.rod_key_view(source="CAMERA", rod_index=rods[name]) == {"FINISHED"}
+                assert bpy.ops.kodawari.rod_key_view(source="CAMERA", rod_index=rods[name]) == {
+                    "FINISHED"
+                }
         if view == "front":
             # Bangs part away from the eyes when seen from the front.
             curl(rig, "BangL", (0, 1, 0), 26)
             curl(rig, "BangR", (0, 1, 0), -26)
             curl(rig, "BangM", (1, 0, 0), -28)
             for name in ("BangL", "BangM", "BangR"):
-                assert bpy.ops.kodawari.rod_key_view(source="CAMERA", rod_index=rods[name]) == {"FINISHED"}
+                assert bpy.ops.kodawari.rod_key_view(source="CAMERA", rod_index=rods[name]) == {
+                    "FINISHED"
+                }
     reset_pose(rig)
     bpy.data.objects.remove(keycam)
 
@@ -202,13 +220,29 @@ def animate(rigs, scene):
         head.rotation_mode = "XYZ"
         frames = np.arange(1, 101, dtype=np.float32)
         t = frames / 24.0
-        rotation = np.stack([0.25 * np.sin(2 * math.pi * 0.7 * t), 0.2 * np.sin(2 * math.pi * 0.45 * t),
-                             0.3 * np.sin(2 * math.pi * 0.3 * t)], axis=1)
+        rotation = np.stack(
+            [
+                0.25 * np.sin(2 * math.pi * 0.7 * t),
+                0.2 * np.sin(2 * math.pi * 0.45 * t),
+                0.3 * np.sin(2 * math.pi * 0.3 * t),
+            ],
+            axis=1,
+        )
         action = fcurves.ensure_action(rig, f"{rig.name}Motion")
-        fcurves.write_channels(action, rig, 'pose.bones["Head"].rotation_euler', frames, rotation, group="Head")
-        bob = np.stack([0.04 * np.sin(2 * math.pi * 0.9 * t), np.zeros_like(t), 0.03 * np.sin(2 * math.pi * 1.3 * t)],
-                       axis=1)
-        fcurves.write_channels(action, rig, 'pose.bones["Head"].location', frames, bob, group="Head")
+        fcurves.write_channels(
+            action, rig, 'pose.bones["Head"].rotation_euler', frames, rotation, group="Head"
+        )
+        bob = np.stack(
+            [
+                0.04 * np.sin(2 * math.pi * 0.9 * t),
+                np.zeros_like(t),
+                0.03 * np.sin(2 * math.pi * 1.3 * t),
+            ],
+            axis=1,
+        )
+        fcurves.write_channels(
+            action, rig, 'pose.bones["Head"].location', frames, bob, group="Head"
+        )
     pivot = bpy.data.objects.new("Orbit", None)
     scene.collection.objects.link(pivot)
     pivot.location = (0, 0, 1.8)
@@ -220,8 +254,13 @@ def animate(rigs, scene):
     camera.rotation_euler = (math.radians(90), 0, 0)
     frames = np.array([1, 101], dtype=np.float32)
     angles = (frames - FRAMES["front"]) / 96.0 * 2 * math.pi
-    fcurves.write_channels(fcurves.ensure_action(pivot, "Orbit"), pivot, "rotation_euler", frames,
-                           np.stack([np.zeros(2), np.zeros(2), angles], axis=1))
+    fcurves.write_channels(
+        fcurves.ensure_action(pivot, "Orbit"),
+        pivot,
+        "rotation_euler",
+        frames,
+        np.stack([np.zeros(2), np.zeros(2), angles], axis=1),
+    )
     scene.camera = camera
     return camera
 
@@ -285,8 +324,10 @@ GLYPHS = {
 
 def text_mask(text, scale):
     """Boolean (9 * scale, 6 * scale * len(text)) mask of `text`, one column of space per glyph."""
-    columns = [np.array([[c == "#" for c in row + " "] for row in (GLYPHS[ch] + ("     ",) * 2)[:9]])
-               for ch in text.lower()]
+    columns = [
+        np.array([[c == "#" for c in row + " "] for row in (GLYPHS[ch] + ("     ",) * 2)[:9]])
+        for ch in text.lower()
+    ]
     mask = np.concatenate(columns, axis=1)
     return np.kron(mask, np.ones((scale, scale), dtype=bool))
 
@@ -296,9 +337,9 @@ def draw_text(image, text, top, left, scale=3, color=(0.05, 0.05, 0.08)):
     mask = text_mask(text, scale)
     pad = scale * 2
     h, w = mask.shape
-    plate = image[top:top + h + 2 * pad, left:left + w + 2 * pad]
+    plate = image[top : top + h + 2 * pad, left : left + w + 2 * pad]
     plate[..., :3] = 0.5 * plate[..., :3] + 0.5 * 0.95
-    region = image[top + pad:top + pad + h, left + pad:left + pad + w]
+    region = image[top + pad : top + pad + h, left + pad : left + pad + w]
     region[mask, :3] = color
 
 
@@ -356,9 +397,22 @@ def swing_demo(scene, mats, hidden):
         frames.append(path)
     gif = os.path.join(OUT, "hair_swing.gif")
     try:
-        subprocess.run(["ffmpeg", "-y", "-loglevel", "error", "-framerate", "12", "-i",
-                        os.path.join(OUT, "_swing_%03d.png"), "-vf",
-                        "split[a][b];[a]palettegen=max_colors=64[p];[b][p]paletteuse", gif], check=True)
+        subprocess.run(
+            [
+                "ffmpeg",
+                "-y",
+                "-loglevel",
+                "error",
+                "-framerate",
+                "12",
+                "-i",
+                os.path.join(OUT, "_swing_%03d.png"),
+                "-vf",
+                "split[a][b];[a]palettegen=max_colors=64[p];[b][p]paletteuse",
+                gif,
+            ],
+            check=True,
+        )
         print(f"wrote {gif}")
     except (OSError, subprocess.CalledProcessError) as exc:
         print(f"no GIF ({exc}): the frames are out/_swing_*.png")
@@ -386,8 +440,12 @@ def main():
     scene = bpy.context.scene
     scene.frame_start, scene.frame_end = 1, 100
     scene.render.fps = 24
-    mats = {"skin": material("Skin", (0.9, 0.72, 0.62)), "eye": material("Eye", (0.02, 0.02, 0.03)),
-            "hair": material("Hair", (0.25, 0.12, 0.4)), "ear": material("Ear", (0.95, 0.93, 0.92))}
+    mats = {
+        "skin": material("Skin", (0.9, 0.72, 0.62)),
+        "eye": material("Eye", (0.02, 0.02, 0.03)),
+        "hair": material("Hair", (0.25, 0.12, 0.4)),
+        "ear": material("Ear", (0.95, 0.93, 0.92)),
+    }
     plain, plain_collection = build_character("Plain", mats)
     kodawari, kodawari_collection = build_character("Kodawari", mats)
     add_rods(plain)
@@ -404,7 +462,10 @@ def main():
         rig.hide_render = True
     bpy.ops.wm.save_as_mainfile(filepath=os.path.join(OUT, "hair.blend"))
     rows = []
-    for collection, other in ((plain_collection, kodawari_collection), (kodawari_collection, plain_collection)):
+    for collection, other in (
+        (plain_collection, kodawari_collection),
+        (kodawari_collection, plain_collection),
+    ):
         collection.hide_render, other.hide_render = False, True
         row = []
         for view, frame in FRAMES.items():

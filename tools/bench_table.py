@@ -51,23 +51,33 @@ def mem_ratio(a, b):
 
 
 def fish_table(runs, out):
-    out.append("### Fish swim, whole frame (`scene.frame_set` + evaluation + normals read), ms per frame")
+    out.append(
+        "### Fish swim, whole frame (`scene.frame_set` + evaluation + normals read), ms per frame"
+    )
     out.append("")
-    out.append("Kodawari = live handler, native FFD, shape-key write, Blender's evaluation of the key. "
-               "Geometry Nodes = Sample Curve → Set Position along the same animated curve (the fish's own control "
-               "axis, keyed per frame). Curve modifier = the same curve. Floor = the same mesh whose only change is "
-               "an animated shape-key value. Ratios use the medians; memory ratios the peak above start.")
+    out.append(
+        "Kodawari = live handler, native FFD, shape-key write, Blender's evaluation of the key. "
+        "Geometry Nodes = Sample Curve → Set Position along the same animated curve (the fish's own control "
+        "axis, keyed per frame). Curve modifier = the same curve. Floor = the same mesh whose only change is "
+        "an animated shape-key value. Ratios use the medians; memory ratios the peak above start."
+    )
     out.append("")
-    out.append("| Blender | vertices | Kodawari | Geometry Nodes | Curve modifier | floor | Kodawari ÷ GN | "
-               "Kodawari ÷ floor | Kodawari ÷ Curve | peak RSS Kodawari / GN / Curve / floor | memory Kodawari ÷ GN | load |")
+    out.append(
+        "| Blender | vertices | Kodawari | Geometry Nodes | Curve modifier | floor | Kodawari ÷ GN | "
+        "Kodawari ÷ floor | Kodawari ÷ Curve | peak RSS Kodawari / GN / Curve / floor | memory Kodawari ÷ GN | load |"
+    )
     out.append("|---|---|---|---|---|---|---|---|---|---|---|---|")
-    for key, run in runs:
+    for _, run in runs:
         for size in run.get("fish", []):
             r = size["rows"]
-            k, g, c, f = (r.get(s) for s in ("kodawari", "geometry_nodes", "curve_modifier", "floor"))
-            out.append(f"| {run['blender']} | {size['vertices']:,} | {ms(k)} | {ms(g)} | {ms(c)} | {ms(f)} | "
-                       f"{ratio(k, g)} | {ratio(k, f)} | {ratio(k, c)} | {mem(k)} / {mem(g)} / {mem(c)} / {mem(f)} | "
-                       f"{mem_ratio(k, g)} | {k.get('load', 'n/a')} |")
+            k, g, c, f = (
+                r.get(s) for s in ("kodawari", "geometry_nodes", "curve_modifier", "floor")
+            )
+            out.append(
+                f"| {run['blender']} | {size['vertices']:,} | {ms(k)} | {ms(g)} | {ms(c)} | {ms(f)} | "
+                f"{ratio(k, g)} | {ratio(k, f)} | {ratio(k, c)} | {mem(k)} / {mem(g)} / {mem(c)} / {mem(f)} | "
+                f"{mem_ratio(k, g)} | {k.get('load', 'n/a')} |"
+            )
     out.append("")
 
 
@@ -75,61 +85,82 @@ def fish_live_table(runs, out):
     rows = [(run["blender"], run["fish_live"]) for _, run in runs if "fish_live" in run]
     if not rows:
         return
-    out.append("### Live fish frame early and late in the timeline (~25 k vertices, fins, frequency keyframed), ms per whole frame")
+    out.append(
+        "### Live fish frame early and late in the timeline (~25 k vertices, fins, frequency keyframed), ms per whole frame"
+    )
     out.append("")
     out.append("| Blender | frame 10 | frame 10,000 | 10,000 ÷ 10 | load |")
     out.append("|---|---|---|---|---|")
     for blender, r in rows:
-        out.append(f"| {blender} | {ms(r['frame_10'])} | {ms(r['frame_10000'])} | "
-                   f"{ratio(r['frame_10000'], r['frame_10'])} | {r['frame_10'].get('load')} |")
+        out.append(
+            f"| {blender} | {ms(r['frame_10'])} | {ms(r['frame_10000'])} | "
+            f"{ratio(r['frame_10000'], r['frame_10'])} | {r['frame_10'].get('load')} |"
+        )
     out.append("")
 
 
 def hair_table(runs, out):
     out.append("### Hair, whole frame (`scene.frame_set` + evaluation), ms per frame")
     out.append("")
-    out.append("Chains of 16 connected bones under an animated head bone. Kodawari = live rods, 4 substeps. Bare = the same "
-               "rig, hair off. Wiggle 2 port = Wiggle 2's per-bone Python algorithm ported into the benchmark "
-               "(tests/bench/wiggle2_port.py; Wiggle 2 itself cannot be installed here), every chain bone's tail "
-               "wiggling, Quality 2.")
+    out.append(
+        "Chains of 16 connected bones under an animated head bone. Kodawari = live rods, 4 substeps. Bare = the same "
+        "rig, hair off. Wiggle 2 port = Wiggle 2's per-bone Python algorithm ported into the benchmark "
+        "(tests/bench/wiggle2_port.py; Wiggle 2 itself cannot be installed here), every chain bone's tail "
+        "wiggling, Quality 2."
+    )
     out.append("")
-    out.append("| Blender | chain bones | Kodawari | bare | Wiggle 2 port | Kodawari ÷ bare | port ÷ Kodawari | "
-               "peak RSS Kodawari / bare / port | load |")
+    out.append(
+        "| Blender | chain bones | Kodawari | bare | Wiggle 2 port | Kodawari ÷ bare | port ÷ Kodawari | "
+        "peak RSS Kodawari / bare / port | load |"
+    )
     out.append("|---|---|---|---|---|---|---|---|---|")
-    for key, run in runs:
+    for _, run in runs:
         for size in run.get("hair", []):
             r = size["rows"]
             k, b, w = (r.get(s) for s in ("kodawari", "bare", "wiggle2_port"))
-            out.append(f"| {run['blender']} | {size['bones']:,} | {ms(k)} | {ms(b)} | {ms(w)} | {ratio(k, b)} | "
-                       f"{ratio(w, k)} | {mem(k)} / {mem(b)} / {mem(w)} | {k.get('load', 'n/a')} |")
+            out.append(
+                f"| {run['blender']} | {size['bones']:,} | {ms(k)} | {ms(b)} | {ms(w)} | {ratio(k, b)} | "
+                f"{ratio(w, k)} | {mem(k)} / {mem(b)} / {mem(w)} | {k.get('load', 'n/a')} |"
+            )
     out.append("")
 
 
 def gait_table(runs, out):
     out.append("### Gait bake, seconds per bake (horse, 4 legs × 4 bones + body)")
     out.append("")
-    out.append("Kodawari = `kodawari.gait_bake` end to end. IK = the same planned feet and body, legs by Blender's IK "
-               "constraints, `nla.bake` visual keying into a new, empty action. *Extrapolated* figures were not run: "
-               "they follow the measured growth between the two shortest IK bakes (stated in out/bench.json).")
+    out.append(
+        "Kodawari = `kodawari.gait_bake` end to end. IK = the same planned feet and body, legs by Blender's IK "
+        "constraints, `nla.bake` visual keying into a new, empty action. *Extrapolated* figures were not run: "
+        "they follow the measured growth between the two shortest IK bakes (stated in out/bench.json)."
+    )
     out.append("")
-    out.append("| Blender | frames | Kodawari | IK + nla.bake | IK ÷ Kodawari | peak RSS Kodawari / IK | load |")
+    out.append(
+        "| Blender | frames | Kodawari | IK + nla.bake | IK ÷ Kodawari | peak RSS Kodawari / IK | load |"
+    )
     out.append("|---|---|---|---|---|---|---|")
-    for key, run in runs:
+    for _, run in runs:
         rows = run.get("gait", [])
         for ours in (r for r in rows if r["side"] == "kodawari"):
-            theirs = next((r for r in rows if r["side"] == "blender_ik" and r["frames"] == ours["frames"]), {})
+            theirs = next(
+                (r for r in rows if r["side"] == "blender_ik" and r["frames"] == ours["frames"]), {}
+            )
 
             def s(row):
                 if "s_min" not in row:
                     return "n/a"
                 if row.get("extrapolated"):
                     return f"~{row['s_min']:.0f} (*extrapolated*)"
-                return f"{row['s_min']:.3g} / {row['s_median']:.3g}" + (" (1 bake)" if row.get("rounds") == 1 else "")
+                return f"{row['s_min']:.3g} / {row['s_median']:.3g}" + (
+                    " (1 bake)" if row.get("rounds") == 1 else ""
+                )
+
             r = ratio(theirs, ours, "s_min") if "s_min" in theirs and "s_min" in ours else "n/a"
             if theirs.get("extrapolated") and r != "n/a":
                 r = f"~{r} (*extrapolated*)"
-            out.append(f"| {run['blender']} | {ours['frames']:,} | {s(ours)} | {s(theirs)} | {r} | "
-                       f"{mem(ours)} / {mem(theirs)} | {ours.get('load', 'n/a')} |")
+            out.append(
+                f"| {run['blender']} | {ours['frames']:,} | {s(ours)} | {s(theirs)} | {r} | "
+                f"{mem(ours)} / {mem(theirs)} | {ours.get('load', 'n/a')} |"
+            )
     out.append("")
 
 
@@ -138,25 +169,34 @@ def solver_table(runs, out):
     out.append("")
     out.append("| Blender | case | handler (read, solve, write) | native solve alone |")
     out.append("|---|---|---|---|")
-    for key, run in runs:
+    for _, run in runs:
         for size in run.get("fish", []):
             s = size["solver"]
-            out.append(f"| {run['blender']} | fish {size['vertices']:,} vertices | {s['handler_ms_min']:.2f} / "
-                       f"{s['handler_ms_median']:.2f} | FFD deform {s['deform_ms_min']:.2f} / {s['deform_ms_median']:.2f} "
-                       f"({s['deform_ms_min'] * 1e6 / size['vertices']:.2f} ns/vertex) |")
+            out.append(
+                f"| {run['blender']} | fish {size['vertices']:,} vertices | {s['handler_ms_min']:.2f} / "
+                f"{s['handler_ms_median']:.2f} | FFD deform {s['deform_ms_min']:.2f} / {s['deform_ms_median']:.2f} "
+                f"({s['deform_ms_min'] * 1e6 / size['vertices']:.2f} ns/vertex) |"
+            )
         for size in run.get("hair", []):
             s = size["solver"]
-            out.append(f"| {run['blender']} | hair {size['bones']:,} bones | {s['handler_ms_min']:.2f} / "
-                       f"{s['handler_ms_median']:.2f} ({s['handler_ms_min'] * 1e3 / size['bones']:.2f} µs/bone) | "
-                       f"rod step {s['step_ms_min']:.2f} / {s['step_ms_median']:.2f} |")
+            out.append(
+                f"| {run['blender']} | hair {size['bones']:,} bones | {s['handler_ms_min']:.2f} / "
+                f"{s['handler_ms_median']:.2f} ({s['handler_ms_min'] * 1e3 / size['bones']:.2f} µs/bone) | "
+                f"rod step {s['step_ms_min']:.2f} / {s['step_ms_median']:.2f} |"
+            )
     out.append("")
 
 
 def main(path="out/bench.json"):
     with open(path) as f:
         data = json.load(f)
-    runs = sorted(data.get("runs", {}).items(), key=lambda kv: tuple(int(x) for x in kv[0].split(".")))
-    out = ["## Speed, measured by `make bench` (min / median of 3 rounds; machine load = 1-min load average)", ""]
+    runs = sorted(
+        data.get("runs", {}).items(), key=lambda kv: tuple(int(x) for x in kv[0].split("."))
+    )
+    out = [
+        "## Speed, measured by `make bench` (min / median of 3 rounds; machine load = 1-min load average)",
+        "",
+    ]
     fish_table(runs, out)
     hair_table(runs, out)
     fish_live_table(runs, out)

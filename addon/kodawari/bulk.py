@@ -32,7 +32,9 @@ def shape_key_positions(key_block, out=None):
 
 def set_shape_key_positions(key_block, positions):
     """Write float32 (N, 3) into a shape key and tag its mesh for re-evaluation."""
-    _shape_key_points(key_block).foreach_set("co", np.ascontiguousarray(positions, dtype=np.float32).reshape(-1))
+    _shape_key_points(key_block).foreach_set(
+        "co", np.ascontiguousarray(positions, dtype=np.float32).reshape(-1)
+    )
     key_block.id_data.user.update_tag()
 
 
@@ -90,10 +92,13 @@ def _shape_key_view(key_block, count):
     data = ctypes.c_void_p.from_address(address + _KEYBLOCK_DATA_OFFSET).value
     if not data:
         return None
-    view = np.ctypeslib.as_array((ctypes.c_float * (3 * count)).from_address(data)).reshape(count, 3)
+    view = np.ctypeslib.as_array((ctypes.c_float * (3 * count)).from_address(data)).reshape(
+        count, 3
+    )
     first, last = key_block.data[0].co, key_block.data[count - 1].co
-    if tuple(view[0]) != tuple(np.float32(c) for c in first) or \
-            tuple(view[-1]) != tuple(np.float32(c) for c in last):
+    if tuple(view[0]) != tuple(np.float32(c) for c in first) or tuple(view[-1]) != tuple(
+        np.float32(c) for c in last
+    ):
         return None
     return view
 
@@ -111,7 +116,11 @@ def write_shape_key_positions(key_block, positions):
     # Only where RNA has no raw path (before 4.1) and the layout above is known to hold;
     # 4.1+ writes through ShapeKey.points at the same speed without touching memory.
     raw_ok = _KEYBLOCK_LAYOUT_VERSIONS[0] <= bpy.app.version < _KEYBLOCK_LAYOUT_VERSIONS[1]
-    view = _shape_key_view(key_block, count) if raw_ok and count and positions.shape == (count, 3) else None
+    view = (
+        _shape_key_view(key_block, count)
+        if raw_ok and count and positions.shape == (count, 3)
+        else None
+    )
     if view is None:
         _shape_key_points(key_block).foreach_set("co", positions.reshape(-1))
     else:

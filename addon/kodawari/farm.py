@@ -49,7 +49,7 @@ def _gait_ready(obj):
 def _jobs(scene, context):
     """(object name, job) for every creature of the scene that still needs a bake."""
     from .fish import bake as fish_bake
-    from .fish import runtime as fish_runtime
+    from .fish import visibility as fish_visibility
     from .gait.bake import GaitBakeJob
     from .hair.bake import HairBakeJob
 
@@ -59,7 +59,7 @@ def _jobs(scene, context):
         if obj.type == "ARMATURE" and _gait_ready(obj):
             yield obj.name, lambda obj=obj: GaitBakeJob(context, obj, start, end)
     for obj in objects:
-        if obj.type == "MESH" and fish_runtime.is_live(obj):
+        if obj.type == "MESH" and fish_visibility.renders(obj):  # what the render shows, not the viewport
             yield (
                 obj.name,
                 lambda obj=obj: fish_bake.SwimBakeJob(obj, scene, start, end, "MESH_CACHE"),

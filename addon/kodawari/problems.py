@@ -101,7 +101,7 @@ class KODAWARI_OT_report_problem(bpy.types.Operator):
     bl_label = "Kodawari: Problem"
     bl_options = {"INTERNAL"}
 
-    message: bpy.props.StringProperty(name="Message")
+    message: bpy.props.StringProperty(name="Message", description="The problem to show")
 
     def execute(self, context):
         shown.append(self.message)

@@ -3,7 +3,7 @@
 // dict key, as "ground['cell']"), so bad input never reaches the core:
 //   arrays    checked_array / checked_output: dtype, shape, layout, finite, bounded;
 //             no_overlap: an output must not share memory with an input
-//   numbers   finite_number: finite and within ±kMaxMagnitude
+//   numbers   require_finite: finite and within ±kMaxMagnitude
 //   dicts     dict_arg / item / number_item / int_item / bool_item / sequence_item
 //   vectors   NumPy -> core: vec3, unit_vector, to_points, to_quats, to_vector;
 //             core -> NumPy: vec3_array, points_array, quats_array, to_array
@@ -53,7 +53,7 @@ inline std::string type_name(const py::handle& obj) { return std::string(py::str
 // ---------------------------------------------------------------- numbers
 
 // A finite scalar within ±kMaxMagnitude; ValueError naming it otherwise.
-inline double finite_number(double value, const std::string& name) {
+inline double require_finite(double value, const std::string& name) {
   if (!std::isfinite(value)) throw py::value_error(name + " must be finite, got " + std::to_string(value));
   if (std::abs(value) > kMaxMagnitude) {
     throw py::value_error(name + " is out of range (|value| must be <= " + kMaxMagnitudeText + ")");
@@ -152,7 +152,7 @@ inline double number_item(const py::dict& d, const char* key, const std::string&
   } catch (const py::cast_error&) {
     throw py::value_error(name + " must be a number, got " + type_name(v));
   }
-  return finite_number(value, name);
+  return require_finite(value, name);
 }
 
 inline int int_item(const py::dict& d, const char* key, const std::string& where) {
@@ -200,13 +200,17 @@ inline Vec3 unit_vector(const py::handle& obj, const std::string& name) {
   return v.normalized();
 }
 
-// float64 (rows, 3) -> points (rows < 0: any count).
-inline Vec3List to_points(const py::handle& obj, const std::string& name, py::ssize_t rows = -1) {
-  const auto a = checked_array<double>(obj, name, rows, 3);
-  const double* d = a.data();
-  Vec3List points(static_cast<std::size_t>(a.shape(0)));
+// An already checked float64 (N, 3) array -> points.
+inline Vec3List to_points(const py::array_t<double>& checked) {
+  const double* d = checked.data();
+  Vec3List points(static_cast<std::size_t>(checked.shape(0)));
   for (std::size_t i = 0; i < points.size(); ++i) points[i] = Vec3(d[3 * i], d[3 * i + 1], d[3 * i + 2]);
   return points;
+}
+
+// float64 (rows, 3) -> points (rows < 0: any count).
+inline Vec3List to_points(const py::handle& obj, const std::string& name, py::ssize_t rows = -1) {
+  return to_points(checked_array<double>(obj, name, rows, 3));
 }
 
 // float64 (rows, 4) (w, x, y, z) -> quaternions, as written (not normalised).

@@ -133,7 +133,7 @@ void bind_gait(py::module_& m) {
       "(frame index, top speed) of the first frame faster than its gait mode allows, or (-1, 0).");
 
   m.def("gait_validate_table", [](const py::dict& table) { return validate_table(table_from(table)); },
-        "Empty string when the table is usable, else what is wrong.");
+        py::arg("table"), "Empty string when the table is usable, else what is wrong.");
 
   m.def("gait_validate_rig", [](const py::dict& rig) {
         try {
@@ -142,7 +142,7 @@ void bind_gait(py::module_& m) {
           return std::string(e.what());
         }
         return std::string();
-      }, "Empty string when the rig can be solved, else what is wrong.");
+      }, py::arg("rig"), "Empty string when the rig can be solved, else what is wrong.");
 
   m.def("gait_leg_phases", [](const py::dict& table, int gait) {
         if (gait < 0 || gait >= kGaitCount) throw py::value_error("gait must be 0..4");
@@ -150,13 +150,13 @@ void bind_gait(py::module_& m) {
         py::array_t<double> out(kLegCount);
         for (int leg = 0; leg < kLegCount; ++leg) out.mutable_data()[leg] = leg_phase(t.gaits[gait], static_cast<Gait>(gait), leg);
         return out;
-      }, "Lift-off phase of LF, RF, LH, RH relative to LH for one gait.");
+      }, py::arg("table"), py::arg("gait"), "Lift-off phase of LF, RF, LH, RH relative to LH for one gait.");
 
   m.def("gait_seed_swing_distance", [](double speed_new, double speed_old, double swing_time, double duty_factor,
                                        double since_change, double added_time) {
         for (auto [v, n] : {std::pair{speed_new, "speed_new"}, {speed_old, "speed_old"}, {swing_time, "swing_time"},
                             {duty_factor, "duty_factor"}, {since_change, "since_change"}, {added_time, "added_time"}}) {
-          finite_number(v, n);
+          require_finite(v, n);
         }
         if (!(duty_factor < 1)) throw py::value_error("duty_factor must be < 1");
         const double s = seed_swing_distance(speed_new, speed_old, swing_time, duty_factor, since_change, added_time);
@@ -167,13 +167,13 @@ void bind_gait(py::module_& m) {
         "Seed eq. 3.6: S = V'P/(1-a) + (V'-V)C + V't.");
 
   m.def("gait_table_speed_max", [](const py::dict& table, int gait, double leg_length) {
-        return table_speed_max(table_from(table), gait, finite_number(leg_length, "leg_length"));
+        return table_speed_max(table_from(table), gait, require_finite(leg_length, "leg_length"));
       }, py::arg("table"), py::arg("gait"), py::arg("leg_length"),
       "Fastest speed the table covers: AUTO (gait=-1) or one gait.");
 
   m.def("gait_select", [](const py::dict& table, double speed, int current, double leg_length) {
-        return static_cast<int>(select_gait(table_from(table), finite_number(speed, "speed"), current,
-                                            finite_number(leg_length, "leg_length")));
+        return static_cast<int>(select_gait(table_from(table), require_finite(speed, "speed"), current,
+                                            require_finite(leg_length, "leg_length")));
       }, py::arg("table"), py::arg("speed"), py::arg("current"), py::arg("leg_length"));
 
   m.def("gait_ccd_solve", [](const py::dict& chain, const py::handle& target, const py::handle& angles,
@@ -189,7 +189,7 @@ void bind_gait(py::module_& m) {
         auto t = checked_array<double>(target, "target", 2, 0);
         auto a = checked_array<double>(angles, "angles", n, 0);
         if (iterations < 0 || iterations > 100000) throw py::value_error("iterations must be 0..100000");
-        finite_number(tolerance, "tolerance");
+        require_finite(tolerance, "tolerance");
         c.lengths.assign(lengths.data(), lengths.data() + n);
         c.rest_direction.assign(dirs.data(), dirs.data() + n);
         c.limit_min.assign(lo.data(), lo.data() + n);
@@ -225,7 +225,7 @@ void bind_gait(py::module_& m) {
         }
         if (!(fps > 0 && fps <= 1000)) throw py::value_error("fps must be in (0, 1000]");
         if (!(acceleration > 0)) throw py::value_error("acceleration must be > 0");
-        finite_number(acceleration, "acceleration");
+        require_finite(acceleration, "acceleration");
         // The table's speed range (as gait_table_speed_max gives it): past it no gait fits
         // and the legs cannot follow the body (a 10 km/s bake missed its feet by 55 m).
         double leg_length = 0;

@@ -55,7 +55,7 @@ FrameInput frame_input(const RodSystem& system, const py::handle& bone_matrices,
   in.has_camera = !camera.is_none();
   if (in.has_camera) in.camera = vec3(camera, "camera");
   in.gravity = vec3(gravity, "gravity");
-  finite_number(time, "time");
+  require_finite(time, "time");
   if (!std::isfinite(frame_dt) || frame_dt < 0 || frame_dt > 1e3) throw py::value_error("frame_dt must be in [0, 1000] seconds");
   in.time = time;
   in.frame_dt = frame_dt;
@@ -85,7 +85,7 @@ std::size_t add_rod(RodSystem& system, int parent_bone, int reference_bone, cons
   rod.geometry.offsets = to_points(offsets, "offsets", n + 1);
   rod.geometry.rest_rotations = to_quats(rest_rotations, "rest_rotations", n);
   for (auto [v, name] : {std::pair{stiffness, "stiffness"}, {damping, "damping"}, {gravity, "gravity"}, {radius, "radius"}}) {
-    finite_number(v, name);
+    require_finite(v, name);
   }
   rod.params.stiffness = stiffness;
   rod.params.damping = damping;
@@ -100,6 +100,10 @@ std::size_t add_rod(RodSystem& system, int parent_bone, int reference_bone, cons
     const int c = cond.data()[i];
     if (c < 0 || c > 2) throw py::value_error("key_conditions must be 0 (VIEW), 1 (POSE) or 2 (SPEED)");
     key.condition = static_cast<Condition>(c);
+    const std::string row = "[" + std::to_string(i) + "]";
+    if (c == 0 && !(dirs[i].norm() >= 1e-9)) throw py::value_error("key_directions" + row + ": a view key has a zero or NaN direction");
+    if (c == 1 && !(krot[i].norm() >= 1e-6)) throw py::value_error("key_rotations" + row + ": a pose key has a NaN or zero rotation");
+    if (c == 2 && !(speeds[i] >= 0)) throw py::value_error("key_speeds" + row + ": a speed key needs a speed >= 0");
     key.direction = dirs[i];
     key.rotation = krot[i];
     key.speed = speeds[i];

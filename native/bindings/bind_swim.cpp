@@ -56,7 +56,7 @@ void bind_swim(py::module_& m) {
                             {amplitude, "amplitude"}, {amplitude_head, "amplitude_head"},
                             {envelope_start, "envelope_start"}, {envelope_power, "envelope_power"},
                             {phase_offset, "phase_offset"}}) {
-          finite_number(v, n);
+          require_finite(v, n);
         }
         if (body_length <= 0) throw py::value_error("body_length must be positive");
         if (wavelength <= 0) throw py::value_error("wavelength must be positive");
@@ -82,7 +82,7 @@ void bind_swim(py::module_& m) {
       [](double s, double amplitude, double amplitude_head, double envelope_start, double envelope_power) {
         for (auto [v, n] : {std::pair{s, "s"}, {amplitude, "amplitude"}, {amplitude_head, "amplitude_head"},
                             {envelope_start, "envelope_start"}, {envelope_power, "envelope_power"}}) {
-          finite_number(v, n);
+          require_finite(v, n);
         }
         swim::BodyWave wave;
         wave.amplitude = amplitude;
@@ -106,7 +106,7 @@ void bind_swim(py::module_& m) {
         swim::RootFrame frame{unit_vector(tangent, "tangent"), unit_vector(side, "side"), unit_vector(up, "up")};
         for (auto [v, n] : {std::pair{amplitude, "amplitude"}, {phase, "phase"}, {feathering, "feathering"},
                             {wavelength, "wavelength"}}) {
-          finite_number(v, n);
+          require_finite(v, n);
         }
         if (wavelength <= 0) throw py::value_error("wavelength must be positive");
         swim::FinWave wave{fin_motion_from(motion), amplitude, feathering, feather_on_power, wavelength,
@@ -139,8 +139,8 @@ void bind_swim(py::module_& m) {
       "swim_accumulate_phase",
       [](const py::handle& frequencies, double dt, double phase0) {
         const std::vector<double> values = to_vector(frequencies, "frequencies");
-        finite_number(dt, "dt");
-        finite_number(phase0, "phase0");
+        require_finite(dt, "dt");
+        require_finite(phase0, "phase0");
         const std::vector<double> phase = swim::accumulate_phase(values, dt, phase0);
         return to_array(phase);
       },
@@ -152,7 +152,7 @@ void bind_swim(py::module_& m) {
       [](const std::string& mode, double body_length, double frequency, double amplitude, double strouhal) {
         for (auto [v, n] : {std::pair{body_length, "body_length"}, {frequency, "frequency"}, {amplitude, "amplitude"},
                             {strouhal, "strouhal"}}) {
-          finite_number(v, n);
+          require_finite(v, n);
         }
         const double speed = swim::swim_speed(speed_mode_from(mode), body_length, frequency, amplitude, strouhal);
         if (!std::isfinite(speed)) throw py::value_error("strouhal must not be 0 (the speed is not finite)");

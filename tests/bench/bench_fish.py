@@ -31,7 +31,9 @@ import bpy
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-import benchlib  # noqa: E402
+import benchlib
+
+print = benchlib.say  # each line at once, also through a pipe
 
 # (vertices around, rings along, frames per round)
 SIZES = {100_000: (250, 400, 8), 1_000_000: (1000, 1000, 4), 4_000_000: (2000, 2000, 2)}
@@ -55,7 +57,9 @@ def fish_body_mesh(name, ring, rings):
     co[..., 2] = half_h[:, None] * np.sin(angle)[None, :]
     k = np.arange(ring)
     base = (np.arange(rings - 1) * ring)[:, None]
-    quads = np.stack([base + k, base + ring + k, base + ring + (k + 1) % ring, base + (k + 1) % ring], -1)
+    quads = np.stack(
+        [base + k, base + ring + k, base + ring + (k + 1) % ring, base + (k + 1) % ring], -1
+    )
     quads = quads.reshape(-1, 4).astype(np.int32)
     mesh = bpy.data.meshes.new(name)
     mesh.vertices.add(ring * rings)
@@ -225,8 +229,10 @@ def make_floor(scene, mesh, frames):
     return obj
 
 
-def build_side(side, scene, ring, rings, axes=None, rest_axis=None, frames=()):
-    mesh = fish_body_mesh(f"body_{side}", ring, rings)
+def build_side(side, scene, ring, rings, axes=None, rest_axis=None, frames=(), mesh=None):
+    """One side's objects in `scene`, on a new body mesh (or on `mesh`, a plain copy of it)."""
+    if mesh is None:
+        mesh = fish_body_mesh(f"body_{side}", ring, rings)
     if side == "kodawari":
         return make_kodawari(scene, mesh)
     if side == "geometry_nodes":
@@ -259,6 +265,7 @@ def player(scene, obj, frames):
             whole_frame(scene, obj, frame)
             seconds.append(time.perf_counter() - start)
         return seconds
+
     return play
 
 
@@ -277,16 +284,24 @@ def child(spec):
     start = benchlib.rss_mb()
     axes = {int(k): v for k, v in spec["axes"].items()}
     frames = list(range(1, spec["frames"] + 2))
-    obj = build_side(spec["side"], scene, spec["ring"], spec["rings"], axes, spec["rest_axis"], frames)
+    obj = build_side(
+        spec["side"], scene, spec["ring"], spec["rings"], axes, spec["rest_axis"], frames
+    )
     gc.collect()
     build_peak = benchlib.peak_rss_mb()
     benchlib.reset_peak_rss()  # from here: the peak while playing
     for frame in frames:
         whole_frame(scene, obj, frame)
     play_peak = benchlib.peak_rss_mb()
-    benchlib.child_report({"peak_rss_mb": round(max(build_peak, play_peak), 1),
-                           "above_start_mb": round(play_peak - start, 1), "play_peak_mb": round(play_peak, 1),
-                           "build_peak_mb": round(build_peak, 1), "start_mb": round(start, 1)})
+    benchlib.child_report(
+        {
+            "peak_rss_mb": round(max(build_peak, play_peak), 1),
+            "above_start_mb": round(play_peak - start, 1),
+            "play_peak_mb": round(play_peak, 1),
+            "build_peak_mb": round(build_peak, 1),
+            "start_mb": round(start, 1),
+        }
+    )
 
 
 # ----------------------------------------------------------------------------- parent
@@ -300,11 +315,23 @@ def solver_alone(obj, scene, frames):
     rig = runtime.get_rig(obj)
     evaluate, deform = [], []
     for _ in range(benchlib.ROUNDS):
-        evaluate.append(np.mean([benchlib.timed(lambda f=f: runtime.evaluate(obj, scene, f)) for f in frames]))
-        deform.append(np.mean([benchlib.timed(lambda: rig.binding.deform(rig.axis, rig.positions))
-                               for _ in frames]))
-    return {"handler_ms_min": round(min(evaluate) * 1e3, 3), "handler_ms_median": round(float(np.median(evaluate)) * 1e3, 3),
-            "deform_ms_min": round(min(deform) * 1e3, 3), "deform_ms_median": round(float(np.median(deform)) * 1e3, 3)}
+        evaluate.append(
+            np.mean([benchlib.timed(lambda f=f: runtime.evaluate(obj, scene, f)) for f in frames])
+        )
+        deform.append(
+            np.mean(
+                [
+                    benchlib.timed(lambda: rig.binding.deform(rig.axis, rig.positions))
+                    for _ in frames
+                ]
+            )
+        )
+    return {
+        "handler_ms_min": round(min(evaluate) * 1e3, 3),
+        "handler_ms_median": round(float(np.median(evaluate)) * 1e3, 3),
+        "deform_ms_min": round(min(deform) * 1e3, 3),
+        "deform_ms_median": round(float(np.median(deform)) * 1e3, 3),
+    }
 
 
 def measure_size(count, ring, rings, per_round):
@@ -316,11 +343,17 @@ def measure_size(count, ring, rings, per_round):
     t = time.perf_counter()
     objects, scenes = {}, {}
     scenes["kodawari"] = main_scene
-    objects["kodawari"] = build_side("kodawari", main_scene, ring, rings)
+    body = fish_body_mesh(
+        "body", ring, rings
+    )  # the other sides bend copies of it (faster than rebuilding)
+    objects["kodawari"] = build_side("kodawari", main_scene, ring, rings, mesh=body.copy())
     axes, rest_axis = fish_axes(objects["kodawari"], main_scene, all_frames)
     for side in SIDES[1:]:
         scenes[side] = new_scene(side)
-        objects[side] = build_side(side, scenes[side], ring, rings, axes, rest_axis, all_frames)
+        objects[side] = build_side(
+            side, scenes[side], ring, rings, axes, rest_axis, all_frames, mesh=body.copy()
+        )
+    bpy.data.meshes.remove(body)
     setup = time.perf_counter() - t
     moved = {side: moves(scenes[side], objects[side], frames) for side in SIDES}
     plays = {side: player(scenes[side], objects[side], frames) for side in SIDES}
@@ -328,40 +361,67 @@ def measure_size(count, ring, rings, per_round):
     solver = solver_alone(objects["kodawari"], main_scene, frames)
     process_peak = benchlib.peak_rss_mb()
     del objects, scenes
+    bpy.ops.wm.read_homefile(use_empty=True)  # free this size before its children run
     for side in SIDES:
-        memory = benchlib.run_child(__file__, {"side": side, "ring": ring, "rings": rings, "frames": per_round,
-                                               "axes": axes, "rest_axis": rest_axis})
+        memory = benchlib.run_child(
+            __file__,
+            {
+                "side": side,
+                "ring": ring,
+                "rings": rings,
+                "frames": per_round,
+                "axes": axes,
+                "rest_axis": rest_axis,
+            },
+        )
         rows[side].update(memory)
         rows[side]["moves"] = moved[side]
         rows[side]["vertices"] = ring * rings
         rows[side]["frames_per_round"] = per_round
-    return {"vertices": ring * rings, "rows": rows, "solver": solver, "setup_s": round(setup, 1),
-            "timing_process_peak_mb": round(process_peak, 1)}
+    return {
+        "vertices": ring * rings,
+        "rows": rows,
+        "solver": solver,
+        "setup_s": round(setup, 1),
+        "timing_process_peak_mb": round(process_peak, 1),
+    }
 
 
 def main():
-    print(f"=== fish, whole frame ({benchlib.blender_label()}, {os.cpu_count()} CPUs, load {benchlib.load()}): "
-          f"ms per frame min / median of {benchlib.ROUNDS} rounds; peak RSS per side in its own process")
+    print(
+        f"=== fish, whole frame ({benchlib.blender_label()}, {os.cpu_count()} CPUs, load {benchlib.load()}): "
+        f"ms per frame min / median of {benchlib.ROUNDS} rounds; peak RSS per side in its own process"
+    )
     results = []
     for count, (ring, rings, per_round) in benchlib.sizes(SIZES).items():
         size = measure_size(count, ring, rings, per_round)
         results.append(size)
         rows = size["rows"]
         ours = rows["kodawari"]
-        print(f"  {size['vertices']:>9,} vertices ({per_round} frames/round, set-up {size['setup_s']} s):")
+        print(
+            f"  {size['vertices']:>9,} vertices ({per_round} frames/round, set-up {size['setup_s']} s):"
+        )
         for side in SIDES:
             row = rows[side]
-            ratio = "" if side == "kodawari" else f"  kodawari / this {ours['ms_median'] / row['ms_median']:5.2f}x"
+            ratio = (
+                ""
+                if side == "kodawari"
+                else f"  kodawari / this {ours['ms_median'] / row['ms_median']:5.2f}x"
+            )
             mem_ratio = ""
             if side != "kodawari" and row.get("above_start_mb") and ours.get("above_start_mb"):
                 mem_ratio = f"  mem {ours['above_start_mb'] / row['above_start_mb']:4.2f}x"
             err = f"  [memory child: {row['error']}]" if "error" in row else ""
-            print(f"    {side:15s} {benchlib.fmt_ms(row)}  {benchlib.fmt_mem(row)}  load {row['load']:4.1f}"
-                  f"{ratio}{mem_ratio}{'' if row['moves'] else '  (DID NOT MOVE)'}{err}")
+            print(
+                f"    {side:15s} {benchlib.fmt_ms(row)}  {benchlib.fmt_mem(row)}  load {row['load']:4.1f}"
+                f"{ratio}{mem_ratio}{'' if row['moves'] else '  (DID NOT MOVE)'}{err}"
+            )
         s = size["solver"]
-        print(f"    solver alone: handler (phase + FFD + write) {s['handler_ms_min']:.2f} / {s['handler_ms_median']:.2f} ms,"
-              f" native deform {s['deform_ms_min']:.2f} / {s['deform_ms_median']:.2f} ms"
-              f" = {s['deform_ms_min'] * 1e6 / size['vertices']:.2f} ns/vertex")
+        print(
+            f"    solver alone: handler (phase + FFD + write) {s['handler_ms_min']:.2f} / {s['handler_ms_median']:.2f} ms,"
+            f" native deform {s['deform_ms_min']:.2f} / {s['deform_ms_median']:.2f} ms"
+            f" = {s['deform_ms_min'] * 1e6 / size['vertices']:.2f} ns/vertex"
+        )
         benchlib.record("fish", results)
 
 

@@ -14,9 +14,16 @@ import time
 import bpy
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))),
-                                "blend_samples"))
-import benchlib  # noqa: E402
+sys.path.insert(
+    0,
+    os.path.join(
+        os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))),
+        "blend_samples",
+    ),
+)
+import benchlib
+
+print = benchlib.say  # each line at once, also through a pipe
 import fish_shapes  # noqa: E402
 
 FRAMES = 8
@@ -27,9 +34,13 @@ def build(scene):
     obj = fish_shapes.build_fish("tuna", rings=160, segments=150, fin_rows=6)
     bpy.context.view_layer.objects.active = obj
     obj.select_set(True)
-    assert bpy.ops.kodawari.swim_add(head_axis="POS_X", preset="CARANGIFORM", frequency=2.0) == {"FINISHED"}
+    assert bpy.ops.kodawari.swim_add(head_axis="POS_X", preset="CARANGIFORM", frequency=2.0) == {
+        "FINISHED"
+    }
     for group in obj.vertex_groups:
-        bpy.ops.kodawari.swim_fin_add(vertex_group=group.name, kind=group.name.split("_")[1].upper())
+        bpy.ops.kodawari.swim_fin_add(
+            vertex_group=group.name, kind=group.name.split("_")[1].upper()
+        )
     obj.select_set(False)
     settings = obj.kodawari_swim
     for frame, frequency in ((1, 1.5), (200, 2.5)):
@@ -55,6 +66,7 @@ def player(scene, obj, first):
             whole_frame(scene, obj, frame)
             seconds.append(time.perf_counter() - start)
         return seconds
+
     return play
 
 
@@ -65,15 +77,21 @@ def main():
     scene.frame_start, scene.frame_end = 1, 20_000
     obj = build(scene)
     count = len(obj.data.vertices)
-    rows = benchlib.Rounds().run({name: player(scene, obj, first) for name, first in STARTS.items()})
+    rows = benchlib.Rounds().run(
+        {name: player(scene, obj, first) for name, first in STARTS.items()}
+    )
     peak = benchlib.peak_rss_mb()
     early, late = rows["frame_10"], rows["frame_10000"]
-    print(f"=== live fish frame, {count:,} vertices with fins, frequency keyframed ({benchlib.blender_label()}): "
-          f"ms per whole frame, min / median of {benchlib.ROUNDS} rounds of {FRAMES} frames; process peak {peak:.0f} MB")
+    print(
+        f"=== live fish frame, {count:,} vertices with fins, frequency keyframed ({benchlib.blender_label()}): "
+        f"ms per whole frame, min / median of {benchlib.ROUNDS} rounds of {FRAMES} frames; process peak {peak:.0f} MB"
+    )
     for name in STARTS:
         print(f"    {name:12s} {benchlib.fmt_ms(rows[name])}  load {rows[name]['load']:4.1f}")
-    print(f"    frame 10,000 / frame 10: {late['ms_median'] / early['ms_median']:5.2f}x (min {late['ms_min'] / early['ms_min']:5.2f}x)"
-          "  (target 1.0x)")
+    print(
+        f"    frame 10,000 / frame 10: {late['ms_median'] / early['ms_median']:5.2f}x (min {late['ms_min'] / early['ms_min']:5.2f}x)"
+        "  (target 1.0x)"
+    )
     for row in rows.values():
         row["vertices"] = count
         row["process_peak_rss_mb"] = round(peak, 1)

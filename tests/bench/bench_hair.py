@@ -25,7 +25,9 @@ import numpy as np
 from mathutils import Vector
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-import benchlib  # noqa: E402
+import benchlib
+
+print = benchlib.say  # each line at once, also through a pipe
 import wiggle2_port  # noqa: E402
 
 BONES, SUBSTEPS = 16, 4
@@ -43,7 +45,7 @@ def build_rig(scene, chain_count):
     bpy.ops.object.mode_set(mode="EDIT")
     head = data.edit_bones.new("Head")
     head.head, head.tail = (0, 0, 1.5), (0, 0, 1.8)
-    side = int(math.ceil(math.sqrt(chain_count)))
+    side = math.ceil(math.sqrt(chain_count))
     for c in range(chain_count):
         x, y = (c % side - side / 2) * 0.01, (c // side - side / 2) * 0.01
         parent, position = head, Vector((x, y, 1.8))
@@ -61,8 +63,13 @@ def build_rig(scene, chain_count):
     for rod in obj.kodawari_hair.rods:
         rod.substeps = SUBSTEPS
     head_pb = obj.pose.bones["Head"]
-    for frame, location in ((1, (0, 0, 0)), (6, (0.2, 0, 0.05)), (12, (-0.2, 0.1, 0)), (18, (0, 0, 0)),
-                            (24, (0.1, -0.1, 0))):
+    for frame, location in (
+        (1, (0, 0, 0)),
+        (6, (0.2, 0, 0.05)),
+        (12, (-0.2, 0.1, 0)),
+        (18, (0, 0, 0)),
+        (24, (0.1, -0.1, 0)),
+    ):
         head_pb.location = location
         head_pb.keyframe_insert("location", frame=frame)
     bpy.ops.object.mode_set(mode="OBJECT")
@@ -104,6 +111,7 @@ class Sides:
                 seconds.append(time.perf_counter() - start)
             self.use(None)
             return seconds
+
         return play
 
 
@@ -117,9 +125,15 @@ def child(spec):
     benchlib.reset_peak_rss()  # from here: the peak while playing
     sides.player(spec["side"], list(range(2, spec["frames"] + 2)))(0)
     play_peak = benchlib.peak_rss_mb()
-    benchlib.child_report({"peak_rss_mb": round(max(build_peak, play_peak), 1),
-                           "above_start_mb": round(play_peak - start, 1), "play_peak_mb": round(play_peak, 1),
-                           "build_peak_mb": round(build_peak, 1), "start_mb": round(start, 1)})
+    benchlib.child_report(
+        {
+            "peak_rss_mb": round(max(build_peak, play_peak), 1),
+            "above_start_mb": round(play_peak - start, 1),
+            "play_peak_mb": round(play_peak, 1),
+            "build_peak_mb": round(build_peak, 1),
+            "start_mb": round(start, 1),
+        }
+    )
 
 
 def solver_alone(scene, obj, frames):
@@ -140,10 +154,19 @@ def solver_alone(scene, obj, frames):
         handler.append(np.mean(times))
         armature = np.array([tuple(r) for r in obj.matrix_world], np.float64)
         camera, gravity = np.array([0.0, -5.0, 1.7]), np.array([0.0, 0.0, -9.81])
-        native.append(np.mean([benchlib.timed(lambda i=i: rt.system.step(
-            rt.matrices, armature, camera, gravity, 3.0 + i / 24, 1 / 24, rt.rotations)) for i in range(len(frames))]))
-    return {"handler_ms_min": round(min(handler) * 1e3, 3), "handler_ms_median": round(float(np.median(handler)) * 1e3, 3),
-            "step_ms_min": round(min(native) * 1e3, 3), "step_ms_median": round(float(np.median(native)) * 1e3, 3)}
+
+        def step(i, armature=armature, camera=camera, gravity=gravity):
+            rt.system.step(
+                rt.matrices, armature, camera, gravity, 3.0 + i / 24, 1 / 24, rt.rotations
+            )
+
+        native.append(np.mean([benchlib.timed(lambda i=i: step(i)) for i in range(len(frames))]))
+    return {
+        "handler_ms_min": round(min(handler) * 1e3, 3),
+        "handler_ms_median": round(float(np.median(handler)) * 1e3, 3),
+        "step_ms_min": round(min(native) * 1e3, 3),
+        "step_ms_median": round(float(np.median(native)) * 1e3, 3),
+    }
 
 
 def measure_size(bones, chain_count, frames_ours, frames_port):
@@ -154,11 +177,16 @@ def measure_size(bones, chain_count, frames_ours, frames_port):
     obj = build_rig(scene, chain_count)
     sides = Sides(scene, obj)
     setup = time.perf_counter() - t
-    frames = {side: list(range(2, (frames_port if side == "wiggle2_port" else frames_ours) + 2)) for side in SIDES}
+    frames = {
+        side: list(range(2, (frames_port if side == "wiggle2_port" else frames_ours) + 2))
+        for side in SIDES
+    }
     rows = benchlib.Rounds().run({side: sides.player(side, frames[side]) for side in SIDES})
     solver = solver_alone(scene, obj, frames["kodawari"])
     for side in SIDES:
-        memory = benchlib.run_child(__file__, {"side": side, "chains": chain_count, "frames": len(frames[side])})
+        memory = benchlib.run_child(
+            __file__, {"side": side, "chains": chain_count, "frames": len(frames[side])}
+        )
         rows[side].update(memory)
         rows[side]["bones"] = bones
         rows[side]["frames_per_round"] = len(frames[side])
@@ -166,8 +194,10 @@ def measure_size(bones, chain_count, frames_ours, frames_port):
 
 
 def main():
-    print(f"=== hair, whole frame ({benchlib.blender_label()}, {os.cpu_count()} CPUs, load {benchlib.load()}): "
-          f"ms per frame min / median of {benchlib.ROUNDS} rounds; peak RSS per side in its own process")
+    print(
+        f"=== hair, whole frame ({benchlib.blender_label()}, {os.cpu_count()} CPUs, load {benchlib.load()}): "
+        f"ms per frame min / median of {benchlib.ROUNDS} rounds; peak RSS per side in its own process"
+    )
     results = []
     for bones, (chain_count, frames_ours, frames_port) in benchlib.sizes(SIZES).items():
         size = measure_size(bones, chain_count, frames_ours, frames_port)
@@ -184,12 +214,16 @@ def main():
             else:
                 ratio = f"  this / kodawari {row['ms_median'] / ours['ms_median']:7.1f}x"
             err = f"  [memory child: {row['error']}]" if "error" in row else ""
-            print(f"    {side:13s} {benchlib.fmt_ms(row)}  {benchlib.fmt_mem(row)}  load {row['load']:4.1f}"
-                  f"  ({row['frames_per_round']} frames/round){ratio}{err}")
+            print(
+                f"    {side:13s} {benchlib.fmt_ms(row)}  {benchlib.fmt_mem(row)}  load {row['load']:4.1f}"
+                f"  ({row['frames_per_round']} frames/round){ratio}{err}"
+            )
         s = size["solver"]
-        print(f"    solver alone: handler (read, step, write) {s['handler_ms_min']:.2f} / {s['handler_ms_median']:.2f} ms"
-              f" = {s['handler_ms_min'] * 1e3 / bones:.2f} us/bone; native step {s['step_ms_min']:.2f} /"
-              f" {s['step_ms_median']:.2f} ms")
+        print(
+            f"    solver alone: handler (read, step, write) {s['handler_ms_min']:.2f} / {s['handler_ms_median']:.2f} ms"
+            f" = {s['handler_ms_min'] * 1e3 / bones:.2f} us/bone; native step {s['step_ms_min']:.2f} /"
+            f" {s['step_ms_median']:.2f} ms"
+        )
         benchlib.record("hair", results)
 
 

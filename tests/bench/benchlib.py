@@ -32,6 +32,11 @@ ROUNDS = 3
 CHILD_ENV = "KODAWARI_BENCH_CHILD"
 
 
+def say(*args, **kwargs):
+    """print, flushed: the runner pipes our output, and a long benchmark should show as it goes."""
+    print(*args, **kwargs, flush=True)
+
+
 def sizes(all_sizes):
     """All sizes, or only those listed in $KODAWARI_BENCH_SIZES (comma separated) for a quick look."""
     only = os.environ.get("KODAWARI_BENCH_SIZES")
@@ -135,18 +140,37 @@ def run_child(script, spec, timeout=900):
     # the native library this process has mapped (SIGBUS later).
     home = tempfile.mkdtemp(prefix="kodawari-bench-child-")
     env = dict(os.environ, **{CHILD_ENV: json.dumps(spec)})
-    for name, sub in (("SCRIPTS", "scripts"), ("CONFIG", "config"), ("DATAFILES", "data"), ("EXTENSIONS", "extensions")):
+    for name, sub in (
+        ("SCRIPTS", "scripts"),
+        ("CONFIG", "config"),
+        ("DATAFILES", "data"),
+        ("EXTENSIONS", "extensions"),
+    ):
         env[f"BLENDER_USER_{name}"] = os.path.join(home, sub)
     if bpy.app.binary_path:
-        command = [bpy.app.binary_path, "-b", "--factory-startup", "-noaudio", "--python-exit-code", "1",
-                   "--python", os.path.join(ROOT, "tools", "blender_install_addon.py"), "--python", script]
+        command = [
+            bpy.app.binary_path,
+            "-b",
+            "--factory-startup",
+            "-noaudio",
+            "--python-exit-code",
+            "1",
+            "--python",
+            os.path.join(ROOT, "tools", "blender_install_addon.py"),
+            "--python",
+            script,
+        ]
     else:
-        command = [sys.executable, "-c",
-                   "import runpy, sys; sys.path.insert(0, 'tools')\n"
-                   "from blender_install_addon import install_addon; install_addon()\n"
-                   "runpy.run_path(sys.argv[1], run_name='__main__')", script]
+        bootstrap = (
+            "import runpy, sys; sys.path.insert(0, 'tools')\n"
+            "from blender_install_addon import install_addon; install_addon()\n"
+            "runpy.run_path(sys.argv[1], run_name='__main__')"
+        )
+        command = [sys.executable, "-c", bootstrap, script]
     try:
-        done = subprocess.run(command, cwd=ROOT, env=env, capture_output=True, text=True, timeout=timeout)
+        done = subprocess.run(
+            command, cwd=ROOT, env=env, capture_output=True, text=True, timeout=timeout
+        )
     except subprocess.TimeoutExpired:
         return {"error": f"timed out after {timeout} s"}
     finally:
@@ -186,4 +210,6 @@ def fmt_mem(row):
     if peak is None:
         return "      (memory n/a)"
     above = row.get("above_start_mb")
-    return f"peak {peak:7.0f} MB" + (f" (playing: {above:6.0f} above start)" if above is not None else "")
+    return f"peak {peak:7.0f} MB" + (
+        f" (playing: {above:6.0f} above start)" if above is not None else ""
+    )

@@ -56,7 +56,9 @@ _SETTINGS = {
     "gravity": bpy.props.FloatProperty(default=1.0),
     "wind": bpy.props.FloatProperty(default=1.0),
     "chain": bpy.props.BoolProperty(default=True),
-    "collider_type": bpy.props.EnumProperty(items=[("Object", "Object", ""), ("Collection", "Collection", "")]),
+    "collider_type": bpy.props.EnumProperty(
+        items=[("Object", "Object", ""), ("Collection", "Collection", "")]
+    ),
     "collider": bpy.props.PointerProperty(type=bpy.types.Object),
     "collider_collection": bpy.props.PointerProperty(type=bpy.types.Collection),
     "radius": bpy.props.FloatProperty(min=0.0, default=0.0),
@@ -131,7 +133,11 @@ class WigglePort:
 
     def collide(self, b):
         colliders = []
-        kind, single, group = _get(b, "collider_type"), _get(b, "collider"), _get(b, "collider_collection")
+        kind, single, group = (
+            _get(b, "collider_type"),
+            _get(b, "collider"),
+            _get(b, "collider_collection"),
+        )
         if kind == "Object" and single and single.name in self.scene.objects:
             colliders = [single]
         if kind == "Collection" and group and group in self.scene.collection.children_recursive:
@@ -154,7 +160,9 @@ class WigglePort:
         for c in b.constraints:
             if c.type == "DAMPED_TRACK" and c.target and not c.mute:
                 state = b.kbw_state
-                state.position = state.position * (1 - c.influence) + c.target.location * c.influence
+                state.position = (
+                    state.position * (1 - c.influence) + c.target.location * c.influence
+                )
                 break
 
     def update_matrix(self, b):
@@ -167,7 +175,9 @@ class WigglePort:
         frame = mat
         direction = _relative(frame, Matrix.Translation(state.position)).translation
         rotation = direction.to_track_quat("Y", "Z").to_matrix().to_4x4()
-        stretch = _relative(mat, Matrix.Translation(state.position)).translation.length / b.bone.length
+        stretch = (
+            _relative(mat, Matrix.Translation(state.position)).translation.length / b.bone.length
+        )
         scale = Matrix.Scale(stretch, 4, Vector((0.0, 1.0, 0.0)))
         b.matrix = b.matrix @ rotation @ scale
         state.matrix = _flatten(frame @ rotation @ scale)
@@ -177,7 +187,9 @@ class WigglePort:
         state = b.kbw_state
         damp = max(min(1 - _get(b, "damp") * dt, 1), 0)
         state.velocity = state.velocity * damp
-        force = self.scene.gravity * _get(b, "gravity") + self.wind * _get(b, "wind") / _get(b, "mass")
+        force = self.scene.gravity * _get(b, "gravity") + self.wind * _get(b, "wind") / _get(
+            b, "mass"
+        )
         state.position += state.velocity + force * dt * dt
         self.pin(b)
         self.collide(b)
@@ -199,7 +211,11 @@ class WigglePort:
             # split a correction between the bone's tail and its parent's tail, by mass
             if chained:
                 mass, parent_mass = _get(b, "mass"), _get(p, "mass")
-                fac = (0.5 if mass == parent_mass else mass / (mass + parent_mass)) if sweep else _get(p, "stretch")
+                fac = (
+                    (0.5 if mass == parent_mass else mass / (mass + parent_mass))
+                    if sweep
+                    else _get(p, "stretch")
+                )
                 p.kbw_state.position -= pull * fac
                 state.position += pull * (1 - fac)
             else:
@@ -237,7 +253,10 @@ class WigglePort:
         if frame >= self.last_frame:
             elapsed = frame - self.last_frame
         else:
-            elapsed = min((scene.frame_end - self.last_frame) + (frame - scene.frame_start) + 1, self.last_frame - frame)
+            elapsed = min(
+                (scene.frame_end - self.last_frame) + (frame - scene.frame_start) + 1,
+                self.last_frame - frame,
+            )
         if elapsed > 4:
             elapsed = 1
         self.dt = elapsed / scene.render.fps
@@ -259,6 +278,8 @@ class WigglePort:
             state = b.kbw_state
             bounce = Vector((0.0, 0.0, 0.0))
             if state.collision_normal.length:
-                bounce = state.velocity.reflect(state.collision_normal).project(state.collision_normal) * _get(b, "bounce")
+                bounce = state.velocity.reflect(state.collision_normal).project(
+                    state.collision_normal
+                ) * _get(b, "bounce")
             state.velocity = (state.position - state.position_last) / max(elapsed, 1) + bounce
             state.position_last = state.position

@@ -6,7 +6,9 @@ import bpy
 from mathutils import Euler, Vector
 
 
-def make_rig(scene, chains=(("Ahoge", (0.0, 0.0, 1.8), (0.0, 0.0, 1.0), 5),), bone_length=0.06, branch=False):
+def make_rig(
+    scene, chains=(("Ahoge", (0.0, 0.0, 1.8), (0.0, 0.0, 1.0), 5),), bone_length=0.06, branch=False
+):
     """chains: (name, start, direction, bones). Returns the armature object in pose mode."""
     data = bpy.data.armatures.new("Rig")
     obj = bpy.data.objects.new("Rig", data)
@@ -57,7 +59,11 @@ def select_only(obj, names):
 
 
 def chain_bones(obj, name):
-    return [pb for pb in obj.pose.bones if pb.name.startswith(name + ".") and not pb.name.endswith("branch")]
+    return [
+        pb
+        for pb in obj.pose.bones
+        if pb.name.startswith(name + ".") and not pb.name.endswith("branch")
+    ]
 
 
 def rotations(obj, name):
@@ -78,7 +84,9 @@ def pose_curl(obj, name, axis="X", degrees=20.0):
     """Poses the chain into a curl (each joint turned about its local axis)."""
     for pb in chain_bones(obj, name):
         pb.rotation_mode = "QUATERNION"
-        pb.rotation_quaternion = Euler(tuple(math.radians(degrees) if a == axis else 0.0 for a in "XYZ")).to_quaternion()
+        pb.rotation_quaternion = Euler(
+            tuple(math.radians(degrees) if a == axis else 0.0 for a in "XYZ")
+        ).to_quaternion()
     bpy.context.view_layer.update()
 
 

@@ -1,13 +1,19 @@
 """Live simulation in Blender: keys by view, blends, camera switching and cuts,
 colliders, exact scrubbing, bake == live, save/reload/continue, undo rebuild."""
 
-import math
-import os
-
 import bpy
 import numpy as np
 import pytest
-from hair_rig import add_camera, angle_deg, chain_bones, make_rig, pose_curl, rotations, run_frames, select_only
+from hair_rig import (
+    add_camera,
+    angle_deg,
+    chain_bones,
+    make_rig,
+    pose_curl,
+    rotations,
+    run_frames,
+    select_only,
+)
 from mathutils import Euler
 
 
@@ -80,7 +86,9 @@ def test_without_a_camera_the_chain_takes_the_base_shape_and_says_so(empty_scene
     assert max(angle_deg(q, (1, 0, 0, 0)) for q in rotations(obj, name)) < 1.0
 
 
-def _animate_head(obj, frames=((1, (0, 0, 0)), (12, (0.3, 0, 0.1)), (24, (-0.3, 0.2, 0)), (36, (0, 0, 0)))):
+def _animate_head(
+    obj, frames=((1, (0, 0, 0)), (12, (0.3, 0, 0.1)), (24, (-0.3, 0.2, 0)), (36, (0, 0, 0)))
+):
     head = obj.pose.bones["Head"]
     for frame, location in frames:
         head.location = location
@@ -103,7 +111,9 @@ def test_the_blender_pose_follows_the_solver_and_bone_lengths_hold_every_frame(e
         bones = chain_bones(obj, name)
         blender_joints = np.array([tuple(pb.head) for pb in bones] + [tuple(bones[-1].tail)])
         np.testing.assert_allclose(blender_joints, joints, atol=2e-4)
-    assert np.abs(rotations(obj, name)[:, 1:]).max() > 0.01, "the head's motion should swing the chain"
+    assert np.abs(rotations(obj, name)[:, 1:]).max() > 0.01, (
+        "the head's motion should swing the chain"
+    )
 
 
 def test_scrubbing_back_is_exact_and_the_start_frame_resets(empty_scene):
@@ -137,7 +147,7 @@ def test_reading_only_the_bones_the_solver_needs_gives_the_same_motion(empty_sce
         head.keyframe_insert("rotation_quaternion", frame=frame)
     add_camera(empty_scene, "Front", (0, -4, 1.7))
     runs = []
-    for ratio in (10 ** 9, 1):  # bulk foreach_get, then bone by bone
+    for ratio in (10**9, 1):  # bulk foreach_get, then bone by bone
         monkeypatch.setattr(runtime, "SPARSE_READ_RATIO", ratio)
         runtime.invalidate(obj)
         frames = []
@@ -150,7 +160,9 @@ def test_reading_only_the_bones_the_solver_needs_gives_the_same_motion(empty_sce
     for (bulk, bulk_head), (sparse, sparse_head) in zip(*runs):
         assert np.array_equal(bulk, sparse)
         assert np.array_equal(bulk_head, sparse_head)
-    assert np.abs(runs[1][20][1] - np.array([1.0, 0, 0, 0])).max() > 0.05, "the head's own animation must survive"
+    assert np.abs(runs[1][20][1] - np.array([1.0, 0, 0, 0])).max() > 0.05, (
+        "the head's own animation must survive"
+    )
 
 
 def test_camera_switching_by_markers_changes_the_keyed_shape_without_momentum(empty_scene):
@@ -185,7 +197,9 @@ def test_colliders_keep_every_joint_outside_the_head_sphere(empty_scene):
         scene = bpy.context.scene
         obj, rod, name = _setup(scene, chains=chains, stiffness=0.1, radius=0.01)
         if with_collider:
-            bpy.ops.kodawari.rod_collider_add(bone="Head", shape="SPHERE", radius=radius, offset=(0, 0.15, 0))
+            bpy.ops.kodawari.rod_collider_add(
+                bone="Head", shape="SPHERE", radius=radius, offset=(0, 0.15, 0)
+            )
         closest = np.inf
         for frame in range(1, 60):
             scene.frame_set(frame)
@@ -213,7 +227,9 @@ def test_bake_equals_live(empty_scene, new_action):
     _animate_head(obj)
     add_camera(empty_scene, "Front", (0, -4, 1.7))
     live = _live(empty_scene, obj, name, range(1, 31))
-    assert bpy.ops.kodawari.rod_bake(frame_start=1, frame_end=30, new_action=new_action) == {"FINISHED"}
+    assert bpy.ops.kodawari.rod_bake(frame_start=1, frame_end=30, new_action=new_action) == {
+        "FINISHED"
+    }
     assert not obj.kodawari_hair.enabled
     anim = obj.animation_data
     if new_action:
@@ -223,7 +239,9 @@ def test_bake_equals_live(empty_scene, new_action):
     else:
         baked_action = anim.action
     paths = {fc.data_path for fc in fcurves.action_fcurves(baked_action, obj)}
-    assert all(f'pose.bones["{pb.name}"].rotation_quaternion' in paths for pb in chain_bones(obj, name))
+    assert all(
+        f'pose.bones["{pb.name}"].rotation_quaternion' in paths for pb in chain_bones(obj, name)
+    )
     for frame in (1, 7, 18, 30):
         empty_scene.frame_set(frame)
         np.testing.assert_allclose(rotations(obj, name), live[frame], atol=1e-6)

@@ -36,7 +36,10 @@ def make_vrm_like_rig(scene, bones=16, gap=0.012, seed=3):
         bone.roll = float(rng.uniform(-math.pi, math.pi))
         bone.parent = parent
         bone.use_connect = False
-        parent, position = bone, bone.tail + gap * direction.cross(Vector((1, 0, 0))).normalized() + gap * direction
+        parent, position = (
+            bone,
+            bone.tail + gap * direction.cross(Vector((1, 0, 0))).normalized() + gap * direction,
+        )
     bpy.ops.object.mode_set(mode="POSE")
     return obj
 
@@ -61,7 +64,10 @@ def test_an_unconnected_rolled_chain_starts_from_its_rest_pose_without_a_pop(emp
         empty_scene.frame_set(frame)
         frames.append([tuple(pb.matrix.to_quaternion()) for pb in _chain(obj)])
         if frame == 1:  # frame 1 is the rest pose itself
-            assert max(angle_deg(tuple(pb.rotation_quaternion), (1, 0, 0, 0)) for pb in _chain(obj)) < 1e-3
+            assert (
+                max(angle_deg(tuple(pb.rotation_quaternion), (1, 0, 0, 0)) for pb in _chain(obj))
+                < 1e-3
+            )
     for a, b in zip(frames, frames[1:]):
         change = max(angle_deg(qa, qb) for qa, qb in zip(a, b))
         assert change < 5.0, f"a joint turned {change:.1f} degrees in one frame with the head still"
@@ -87,3 +93,21 @@ def test_a_rod_follows_its_root_bone_through_a_rename(empty_scene):
     assert list(rt.rod_slots) == [0], "the renamed rod must still be simulated"
     moved = max(angle_deg(tuple(pb.rotation_quaternion), (1, 0, 0, 0)) for pb in _chain(obj)[1:])
     assert moved > 1.0, "the head's motion should swing the renamed chain"
+
+
+def test_a_rod_whose_root_is_gone_is_reported_once_during_playback(empty_scene, capsys):
+    from kodawari import problems
+    from kodawari.hair import chains, runtime
+
+    obj = make_vrm_like_rig(empty_scene, bones=4)
+    rod = _add_rod(obj)
+    add_camera(empty_scene, "Front", (0, -4, 1.5))
+    del obj.pose.bones["J_Sec_Hair1_01"][chains.ROD_ID_PROPERTY]  # as a file from before rod IDs
+    obj.data.bones["J_Sec_Hair1_01"].name = "Hair_Side_L.001"
+    runtime.clear()
+    for frame in range(1, 11):
+        empty_scene.frame_set(frame)
+    assert "J_Sec_Hair1_01" in problems.message(obj, "hair")
+    lines = [line for line in capsys.readouterr().out.splitlines() if "stopped" in line]
+    assert len(lines) == 1, lines
+    assert rod.root_bone == "J_Sec_Hair1_01"

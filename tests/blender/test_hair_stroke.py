@@ -31,7 +31,9 @@ ANNOTATION_SCRIPT = textwrap.dedent("""
 
 def _annotation_by_script(scene):
     """An annotation stroke where Python can still create one (3.4 API); None elsewhere."""
-    datablocks = bpy.data.annotations if hasattr(bpy.data, "annotations") else bpy.data.grease_pencils
+    datablocks = (
+        bpy.data.annotations if hasattr(bpy.data, "annotations") else bpy.data.grease_pencils
+    )
     data = datablocks.new("Annotations")
     frame = data.layers.new("Note").frames.new(1)
     if not hasattr(getattr(frame, "strokes", None), "new"):
@@ -56,8 +58,9 @@ def _grease_pencil_object(scene):
     drawing = getattr(frame, "drawing", None)
     if drawing is not None:
         drawing.add_strokes([len(STROKE)])
-        drawing.attributes["position"].data.foreach_set("vector", np.array([tuple(p) for p in STROKE],
-                                                                             np.float32).ravel())
+        drawing.attributes["position"].data.foreach_set(
+            "vector", np.array([tuple(p) for p in STROKE], np.float32).ravel()
+        )
     else:
         stroke = frame.strokes.new()
         stroke.points.add(len(STROKE))
@@ -66,7 +69,9 @@ def _grease_pencil_object(scene):
 
 
 def _setup(scene):
-    obj = make_rig(scene, chains=(("Ahoge", (0.0, 0.0, 1.8), (0.0, 0.0, 1.0), 5),), bone_length=0.08)
+    obj = make_rig(
+        scene, chains=(("Ahoge", (0.0, 0.0, 1.8), (0.0, 0.0, 1.0), 5),), bone_length=0.08
+    )
     select_only(obj, {"Ahoge.00"})
     assert bpy.ops.kodawari.rod_add() == {"FINISHED"}
     cam = add_camera(scene, "Front", (0.0, -5.0, 1.9), look_at=(0.0, 0.0, 1.9))
@@ -97,14 +102,16 @@ def _assert_fitted(scene, cam, obj):
     assert bpy.ops.kodawari.rod_fit_stroke(source="CAMERA") == {"FINISHED"}
     after = _screen_distance_to_stroke(scene, cam, obj)
     assert before > 0.01  # the straight chain is off the curved stroke...
-    assert after < 1e-3   # ...and lies on it on screen after the fit
+    assert after < 1e-3  # ...and lies on it on screen after the fit
     assert [pb.bone.length for pb in chain_bones(obj, "Ahoge")] == lengths
 
 
 def test_fit_stroke_on_an_annotation_made_by_script(empty_scene):
     obj, cam = _setup(empty_scene)
     if _annotation_by_script(empty_scene) is None:
-        pytest.skip("this Blender's Python cannot create annotation strokes (see the file-made test)")
+        pytest.skip(
+            "this Blender's Python cannot create annotation strokes (see the file-made test)"
+        )
     _assert_fitted(empty_scene, cam, obj)
 
 
@@ -119,11 +126,24 @@ def test_fit_stroke_on_an_annotation_from_a_file(empty_scene, tmp_path):
     path = str(tmp_path / "annotation.blend")
     script = tmp_path / "make.py"
     script.write_text(ANNOTATION_SCRIPT.format(points=[tuple(p) for p in STROKE], path=path))
-    subprocess.run([blender, "-b", "--factory-startup", "-noaudio", "--python-exit-code", "1", "--python",
-                    str(script)], check=True, capture_output=True, timeout=120)
+    subprocess.run(
+        [
+            blender,
+            "-b",
+            "--factory-startup",
+            "-noaudio",
+            "--python-exit-code",
+            "1",
+            "--python",
+            str(script),
+        ],
+        check=True,
+        capture_output=True,
+        timeout=120,
+    )
     with bpy.data.libraries.load(path) as (source, target):
         target.scenes = ["Scene"]
-    annotation = getattr(target.scenes[0], "annotation", None) or getattr(target.scenes[0], "grease_pencil")
+    annotation = getattr(target.scenes[0], "annotation", None) or target.scenes[0].grease_pencil
     obj, cam = _setup(empty_scene)
     if hasattr(empty_scene, "annotation"):
         empty_scene.annotation = annotation

@@ -11,7 +11,12 @@ def _setup(scene):
     select_only(obj, {"Ahoge.00"})
     assert bpy.ops.kodawari.rod_add() == {"FINISHED"}
     head = obj.pose.bones["Head"]
-    for frame, location in ((1, (0, 0, 0)), (8, (0.4, 0, 0.2)), (16, (-0.4, 0.2, 0)), (24, (0, 0, 0))):
+    for frame, location in (
+        (1, (0, 0, 0)),
+        (8, (0.4, 0, 0.2)),
+        (16, (-0.4, 0.2, 0)),
+        (24, (0, 0, 0)),
+    ):
         head.location = location
         head.keyframe_insert("location", frame=frame)
     add_camera(scene, "Front", (0, -4, 1.7))
@@ -96,5 +101,7 @@ def test_rendering_the_animation_writes_the_rotations_playback_writes(empty_scen
     _restart(obj)
     played = _play(scene, obj, 1, 12)
     for frame in range(1, 13):
-        np.testing.assert_allclose(rendered[frame], played[frame], atol=1e-6, err_msg=f"frame {frame}")
+        np.testing.assert_allclose(
+            rendered[frame], played[frame], atol=1e-6, err_msg=f"frame {frame}"
+        )
     assert np.abs(played[12] - played[1]).max() > 0.01, "the head's motion should swing the chain"

@@ -137,3 +137,22 @@ def test_a_swim_hidden_in_the_viewport_can_still_be_tuned_and_baked(empty_scene)
     positions = np.empty((len(baked[2].data), 3), dtype=np.float32)
     baked[2].data.foreach_get("co", positions.reshape(-1))
     assert np.abs(positions - original).max() > 1e-3, "the baked frames swim"
+
+
+def test_farm_bake_follows_the_render_toggle_not_the_viewport(empty_scene, tmp_path):
+    """bake_all bakes what a render shows: a swim hidden only in the viewport still renders
+    (so it is baked); one hidden from renders renders its rest shape (so it is not)."""
+    import kodawari
+
+    bpy.ops.wm.save_as_mainfile(filepath=str(tmp_path / "shot.blend"))
+    scene = bpy.context.scene
+    scene.frame_start, scene.frame_end = 1, 3
+    viewport_off = make_fish("tuna")
+    add_swim(viewport_off)
+    viewport_off.kodawari_swim.enabled = False
+    render_off = make_fish("dolphin")
+    add_swim(render_off)
+    render_off.kodawari_swim.show_render = False
+    kodawari.bake_all(save=False, exit_on_failure=False)
+    assert viewport_off.kodawari_swim.baked == "MESH_CACHE"
+    assert render_off.kodawari_swim.baked == "NONE"

@@ -163,6 +163,20 @@ def _cached_rod_method(name):
     return _method(make_self, name, _rod_state)
 
 
+def _set_cache_budget(budget):
+    """Sets the budget, then fills the cache past it: the thinning must keep a usable cache."""
+    system = _chain_system()
+    system.cache_budget = budget
+    out = np.tile(np.array([1.0, 0, 0, 0], np.float32), (6, 1))
+    args = _frame_args()
+    for frame in range(1, 30):
+        system.step(
+            args["bone_matrices"], np.eye(4), None, args["gravity"], frame / 24, 1 / 24, out
+        )
+        system.store_frame(frame, out)
+    return system.cache_budget, system.cache_bytes, system.cached_frames(), _rod_state(system)
+
+
 def _fin_args():
     return {
         "rest_points": np.column_stack([np.zeros(5), np.linspace(0, 0.4, 5), np.zeros(5)]),
@@ -420,6 +434,14 @@ TARGETS = [
         _cached_rod_method("cached_rotations"),
         examples=20,
     ),
+    Target("RodSystem.cache_budget", lambda: {"budget": 4096}, _set_cache_budget, examples=40),
+    Target("RodSystem.cache_bytes", dict, lambda: _chain_system().cache_bytes, examples=1),
+    Target(
+        "RodSystem.cache_checkpoint_interval",
+        dict,
+        lambda: _chain_system().cache_checkpoint_interval,
+        examples=1,
+    ),
     # --- gait
     Target("gait_horse_table", dict, kn.gait_horse_table, examples=1),
     Target("gait_validate_table", lambda: {"table": kn.gait_horse_table()}, kn.gait_validate_table),
@@ -462,6 +484,16 @@ TARGETS = [
         examples=80,
     ),
     Target("gait_bake", _gait_bake_args, kn.gait_bake, examples=70),
+    # The dict arguments alone, each mutated more often than among the nine arguments.
+    *[
+        Target(
+            f"gait_bake:{key}",
+            lambda key=key: {key: _gait_bake_args()[key]},
+            lambda key=key, **kw: kn.gait_bake(**{**_gait_bake_args(), **kw}),
+            examples=60,
+        )
+        for key in ("ground", "rig", "table")
+    ],
     Target(
         "gait_forward_kinematics",
         lambda: {

@@ -2,18 +2,19 @@
 kinematic parent and reference), bones 1..n a straight chain along the head's +Y
 starting at `root_offset`; matrices are packed as pose.bones.foreach_get("matrix") does."""
 
-import numpy as np
-
 import kodawari_native as kn
+import numpy as np
 
 
 def quat_to_matrix(q):
     w, x, y, z = q / np.linalg.norm(q)
-    return np.array([
-        [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-        [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-        [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
-    ])
+    return np.array(
+        [
+            [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+            [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+            [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
+        ]
+    )
 
 
 def axis_angle_quat(axis, angle):
@@ -31,8 +32,17 @@ def pack_matrices(rotations, positions):
 
 
 class Chain:
-    def __init__(self, bones=6, length=0.1, root_offset=(0.0, 0.2, 0.0), keys=(), threads=0, colliders=None,
-                 momentum_control=True, **params):
+    def __init__(
+        self,
+        bones=6,
+        length=0.1,
+        root_offset=(0.0, 0.2, 0.0),
+        keys=(),
+        threads=0,
+        colliders=None,
+        momentum_control=True,
+        **params,
+    ):
         self.n = bones
         self.length = length
         self.bone_count = bones + 1
@@ -41,16 +51,31 @@ class Chain:
         rest = np.tile([1.0, 0, 0, 0], (bones, 1))
         conditions = np.array([k["condition"] for k in keys], dtype=np.int32)
         m = len(keys)
-        directions = np.array([k.get("direction", (0, 1, 0)) for k in keys], dtype=np.float64).reshape(m, 3)
-        rotations = np.array([k.get("rotation", (1, 0, 0, 0)) for k in keys], dtype=np.float64).reshape(m, 4)
+        directions = np.array(
+            [k.get("direction", (0, 1, 0)) for k in keys], dtype=np.float64
+        ).reshape(m, 3)
+        rotations = np.array(
+            [k.get("rotation", (1, 0, 0, 0)) for k in keys], dtype=np.float64
+        ).reshape(m, 4)
         speeds = np.array([k.get("speed", 0.0) for k in keys], dtype=np.float64)
         influences = np.array([k.get("influence", 2.4) for k in keys], dtype=np.float64)
         shapes = np.array([k["shape"] for k in keys], dtype=np.float64).reshape(m * bones, 4)
         params.setdefault("wind", np.zeros(3))
-        self.rod = self.system.add_rod(0, 0, np.arange(1, bones + 1, dtype=np.int32), offsets, rest,
-                                       key_conditions=conditions, key_directions=directions,
-                                       key_rotations=rotations, key_speeds=speeds, key_influences=influences,
-                                       key_shapes=shapes, momentum_control=momentum_control, **params)
+        self.rod = self.system.add_rod(
+            0,
+            0,
+            np.arange(1, bones + 1, dtype=np.int32),
+            offsets,
+            rest,
+            key_conditions=conditions,
+            key_directions=directions,
+            key_rotations=rotations,
+            key_speeds=speeds,
+            key_influences=influences,
+            key_shapes=shapes,
+            momentum_control=momentum_control,
+            **params,
+        )
         if colliders is not None:
             self.system.set_colliders(*colliders)
         self.head_rotation = np.eye(3)
@@ -67,13 +92,26 @@ class Chain:
         return pack_matrices(rotations, positions)
 
     def reset(self, camera=None, gravity=(0, 0, -9.81)):
-        self.system.reset(self.matrices(), np.eye(4), None if camera is None else np.asarray(camera, float),
-                          np.asarray(gravity, float), self.time, self.out)
+        self.system.reset(
+            self.matrices(),
+            np.eye(4),
+            None if camera is None else np.asarray(camera, float),
+            np.asarray(gravity, float),
+            self.time,
+            self.out,
+        )
 
     def step(self, camera=None, gravity=(0, 0, -9.81), dt=1 / 24):
         self.time += dt
-        self.system.step(self.matrices(), np.eye(4), None if camera is None else np.asarray(camera, float),
-                         np.asarray(gravity, float), self.time, dt, self.out)
+        self.system.step(
+            self.matrices(),
+            np.eye(4),
+            None if camera is None else np.asarray(camera, float),
+            np.asarray(gravity, float),
+            self.time,
+            dt,
+            self.out,
+        )
         return self.out
 
     def positions(self):

@@ -4,9 +4,8 @@ Unbounded, the cache held every frame's full state: about 2.6 MB per frame at 16
 26 GB after 10,000 frames. With a budget it thins to checkpoints; a dropped frame is
 recomputed from the nearest checkpoint before it, bit for bit."""
 
-import numpy as np
-
 import kodawari_native as kn
+import numpy as np
 
 RODS, BONES = 1000, 16  # 16,000 rod bones
 BUDGET = 32 << 20
@@ -18,10 +17,20 @@ def _system():
     offsets = np.array([(0.0, 0.1, 0.0)] + [(0.0, 0.03, 0.0)] * BONES)
     rest = np.tile([1.0, 0.0, 0.0, 0.0], (BONES, 1))
     for r in range(RODS):
-        system.add_rod(0, 0, np.arange(1 + r * BONES, 1 + (r + 1) * BONES, dtype=np.int32), offsets, rest,
-                       wind=np.zeros(3), key_conditions=np.zeros(0, np.int32), key_directions=np.zeros((0, 3)),
-                       key_rotations=np.zeros((0, 4)), key_speeds=np.zeros(0), key_influences=np.zeros(0),
-                       key_shapes=np.zeros((0, 4)))
+        system.add_rod(
+            0,
+            0,
+            np.arange(1 + r * BONES, 1 + (r + 1) * BONES, dtype=np.int32),
+            offsets,
+            rest,
+            wind=np.zeros(3),
+            key_conditions=np.zeros(0, np.int32),
+            key_directions=np.zeros((0, 3)),
+            key_rotations=np.zeros((0, 4)),
+            key_speeds=np.zeros(0),
+            key_influences=np.zeros(0),
+            key_shapes=np.zeros((0, 4)),
+        )
     return system, bone_count
 
 
@@ -63,7 +72,9 @@ def test_the_cache_keeps_its_budget_over_10000_frames_of_16000_bones_and_scrubbi
 
     # Scrub back to played frames the budget dropped: recompute from the nearest checkpoint.
     for target in (37, 19):
-        assert not system.recall_frame(target, None, True), "the budget should have dropped this frame"
+        assert not system.recall_frame(target, None, True), (
+            "the budget should have dropped this frame"
+        )
         start = system.latest_cached_frame_before(target)
         assert start is not None and start < target
         assert system.recall_frame(start, None, True)

@@ -1,10 +1,9 @@
 """The rod solver (kodawari_native.RodSystem) against the behaviour issue 4 asks for."""
 
+import kodawari_native as kn
 import numpy as np
 import pytest
 from rod_chain import Chain, axis_angle_quat, quat_to_matrix
-
-import kodawari_native as kn
 
 NO_GRAVITY = (0.0, 0.0, 0.0)
 IDENTITY = [1.0, 0.0, 0.0, 0.0]
@@ -20,7 +19,9 @@ def curl(axis, degrees, bones=6):
 
 
 def joint_angles(out, shape):
-    return [angle_deg(out[k + 1].astype(float), np.asarray(shape[k], float)) for k in range(len(shape))]
+    return [
+        angle_deg(out[k + 1].astype(float), np.asarray(shape[k], float)) for k in range(len(shape))
+    ]
 
 
 def test_without_keys_and_gravity_the_chain_settles_back_to_rest_after_the_head_moves():
@@ -53,14 +54,18 @@ def test_camera_on_a_keyed_direction_with_large_influence_settles_on_that_key_wi
 def test_between_two_keys_the_chain_takes_their_blend():
     a = curl((0, 0, 1), 20)
     b = curl((1, 0, 0), 20)
-    keys = [dict(condition=0, direction=(1, 0, 0), influence=1.0, shape=a),
-            dict(condition=0, direction=(-1, 0, 0), influence=1.0, shape=b)]
+    keys = [
+        dict(condition=0, direction=(1, 0, 0), influence=1.0, shape=a),
+        dict(condition=0, direction=(-1, 0, 0), influence=1.0, shape=b),
+    ]
     chain = Chain(keys=keys)
     chain.reset(camera=(0, 0, 5), gravity=NO_GRAVITY)
     for _ in range(120):
         chain.step(camera=(0, 0, 5), gravity=NO_GRAVITY)
     w = chain.system.weights(0)
-    np.testing.assert_allclose(w, kn.view_weights(np.array([[1.0, 0, 0], [-1.0, 0, 0]]), np.ones(2), np.array([0, 0, 1.0])))
+    np.testing.assert_allclose(
+        w, kn.view_weights(np.array([[1.0, 0, 0], [-1.0, 0, 0]]), np.ones(2), np.array([0, 0, 1.0]))
+    )
     np.testing.assert_allclose(w, [0.0, 0.5, 0.5])
     blend = (np.array(a[0]) + np.array(b[0])) / 2
     blend /= np.linalg.norm(blend)
@@ -70,13 +75,23 @@ def test_between_two_keys_the_chain_takes_their_blend():
 
 
 def test_bone_lengths_stay_within_a_tenth_of_a_percent_every_frame():
-    sphere = (np.array([0], np.int32), np.array([0], np.int32), np.zeros((1, 3)), np.array([0.15]), np.zeros(1))
-    chain = Chain(bones=12, length=0.05, stiffness=0.3, colliders=sphere, wind=np.array([3.0, 0, 0]))
+    sphere = (
+        np.array([0], np.int32),
+        np.array([0], np.int32),
+        np.zeros((1, 3)),
+        np.array([0.15]),
+        np.zeros(1),
+    )
+    chain = Chain(
+        bones=12, length=0.05, stiffness=0.3, colliders=sphere, wind=np.array([3.0, 0, 0])
+    )
     chain.reset()
     worst = 0.0
     for frame in range(96):
         t = frame / 24
-        chain.head_position = np.array([0.5 * np.sin(9 * t), 0.3 * np.cos(7 * t), 0.2 * np.sin(13 * t)])
+        chain.head_position = np.array(
+            [0.5 * np.sin(9 * t), 0.3 * np.cos(7 * t), 0.2 * np.sin(13 * t)]
+        )
         chain.head_rotation = quat_to_matrix(axis_angle_quat((1, 1, 0), 2.0 * np.sin(8 * t)))
         chain.step()
         lengths = np.linalg.norm(np.diff(chain.positions(), axis=0), axis=1)
@@ -86,7 +101,13 @@ def test_bone_lengths_stay_within_a_tenth_of_a_percent_every_frame():
 
 def test_colliders_keep_every_joint_outside_the_head_sphere():
     radius = 0.15
-    sphere = (np.array([0], np.int32), np.array([0], np.int32), np.zeros((1, 3)), np.array([radius]), np.zeros(1))
+    sphere = (
+        np.array([0], np.int32),
+        np.array([0], np.int32),
+        np.zeros((1, 3)),
+        np.array([radius]),
+        np.zeros(1),
+    )
     chain = Chain(bones=10, length=0.06, stiffness=0.2, radius=0.01, colliders=sphere)
     chain.reset()
     closest = np.inf
@@ -110,8 +131,10 @@ def test_colliders_keep_every_joint_outside_the_head_sphere():
 
 
 def _cut_run(momentum_control):
-    keys = [dict(condition=0, direction=(1, 0, 0), influence=8.0, shape=curl((0, 0, 1), 30)),
-            dict(condition=0, direction=(-1, 0, 0), influence=8.0, shape=curl((0, 0, 1), -30))]
+    keys = [
+        dict(condition=0, direction=(1, 0, 0), influence=8.0, shape=curl((0, 0, 1), 30)),
+        dict(condition=0, direction=(-1, 0, 0), influence=8.0, shape=curl((0, 0, 1), -30)),
+    ]
     chain = Chain(keys=keys, momentum_control=momentum_control)
     chain.reset(camera=(5, 0, 0), gravity=NO_GRAVITY)
     for _ in range(60):
@@ -130,47 +153,71 @@ def test_a_camera_cut_adds_no_momentum():
     before, after, peak, chain = _cut_run(True)
     assert before < 1e-3
     assert after < 1e-2 and peak < 1e-2  # m/s: nothing is flung
-    assert max(joint_angles(chain.out, curl((0, 0, 1), -30))) < 2.0  # yet the new key's shape is taken
+    assert (
+        max(joint_angles(chain.out, curl((0, 0, 1), -30))) < 2.0
+    )  # yet the new key's shape is taken
     _, after_free, peak_free, _ = _cut_run(False)
     assert peak_free > 0.3, "without momentum control the same cut flings the chain"
 
 
 def test_pose_and_speed_keys_weigh_by_their_own_similarity():
     turned = axis_angle_quat((0, 0, 1), np.pi / 2)
-    keys = [dict(condition=1, rotation=turned, influence=4.0, shape=curl((1, 0, 0), 20)),
-            dict(condition=2, speed=2.0, influence=4.0, shape=curl((0, 0, 1), 20))]
+    keys = [
+        dict(condition=1, rotation=turned, influence=4.0, shape=curl((1, 0, 0), 20)),
+        dict(condition=2, speed=2.0, influence=4.0, shape=curl((0, 0, 1), 20)),
+    ]
     chain = Chain(keys=keys)
     chain.reset(gravity=NO_GRAVITY)
     chain.step(gravity=NO_GRAVITY)
     w = chain.system.weights(0)
     # Head unturned: pose similarity cos(90°) -> (0 + 1) / 2; at rest speed similarity exp(-1).
-    np.testing.assert_allclose(w[1:], [0.5 ** 4, np.exp(-1.0) ** 4], rtol=1e-9)
+    np.testing.assert_allclose(w[1:], [0.5**4, np.exp(-1.0) ** 4], rtol=1e-9)
     chain.head_rotation = quat_to_matrix(turned)
     for _ in range(3):
         chain.head_position = chain.head_position + np.array([2.0 / 24, 0, 0])
         chain.step(gravity=NO_GRAVITY)
     assert chain.system.reference_speed(0) == pytest.approx(2.0, rel=1e-5)
     w = chain.system.weights(0)
-    assert w[1] == pytest.approx(0.5, rel=1e-5) and w[2] == pytest.approx(0.5, rel=1e-5) and w[0] < 1e-6
+    assert (
+        w[1] == pytest.approx(0.5, rel=1e-5)
+        and w[2] == pytest.approx(0.5, rel=1e-5)
+        and w[0] < 1e-6
+    )
 
 
 def _run_many(threads, frames=30):
     system = kn.RodSystem(1 + 40 * 5, threads)
     for r in range(40):
-        system.add_rod(0, 0, np.arange(1 + 5 * r, 6 + 5 * r, dtype=np.int32),
-                       np.array([(0.01 * r, 0.2, 0)] + [(0, 0.1, 0)] * 5, float), np.tile([1.0, 0, 0, 0], (5, 1)),
-                       stiffness=0.4, wind=np.array([1.0, 0, 0.5]), key_conditions=np.zeros(1, np.int32),
-                       key_directions=np.array([[1.0, 0, 0]]), key_rotations=np.array([[1.0, 0, 0, 0]]),
-                       key_speeds=np.zeros(1), key_influences=np.array([2.4]),
-                       key_shapes=np.array(curl((0, 0, 1), 25, 5)))
+        system.add_rod(
+            0,
+            0,
+            np.arange(1 + 5 * r, 6 + 5 * r, dtype=np.int32),
+            np.array([(0.01 * r, 0.2, 0)] + [(0, 0.1, 0)] * 5, float),
+            np.tile([1.0, 0, 0, 0], (5, 1)),
+            stiffness=0.4,
+            wind=np.array([1.0, 0, 0.5]),
+            key_conditions=np.zeros(1, np.int32),
+            key_directions=np.array([[1.0, 0, 0]]),
+            key_rotations=np.array([[1.0, 0, 0, 0]]),
+            key_speeds=np.zeros(1),
+            key_influences=np.array([2.4]),
+            key_shapes=np.array(curl((0, 0, 1), 25, 5)),
+        )
     out = np.zeros((system.bone_count, 4), np.float32)
     results = []
     matrices = np.tile(np.eye(4, dtype=np.float32).reshape(16), (system.bone_count, 1))
     system.reset(matrices, np.eye(4), np.array([3.0, 1, 0]), np.array([0, 0, -9.81]), 0.0, out)
     for frame in range(frames):
         matrices[0, 12] = 0.3 * np.sin(frame / 4)  # head x (column-major translation)
-        system.step(matrices, np.eye(4), np.array([3.0 * np.cos(frame / 10), 3.0 * np.sin(frame / 10), 0]),
-                    np.array([0, 0, -9.81]), (frame + 1) / 24, 1 / 24, out)
+        system.step(
+            matrices,
+            np.eye(4),
+            np.array([3.0 * np.cos(frame / 10), 3.0 * np.sin(frame / 10), 0]),
+            np.array([0, 0, -9.81]),
+            (frame + 1) / 24,
+            1 / 24,
+            out,
+        )
         results.append(out.copy())
     return system, np.array(results)
 
@@ -193,7 +240,15 @@ def test_saved_state_continues_exactly():
         frames = []
         for frame in range(10):
             matrices[0, 12] = 0.2 * frame
-            system.step(matrices, np.eye(4), np.array([3.0, 0, 0]), np.array([0, 0, -9.81]), 1 + frame / 24, 1 / 24, out)
+            system.step(
+                matrices,
+                np.eye(4),
+                np.array([3.0, 0, 0]),
+                np.array([0, 0, -9.81]),
+                1 + frame / 24,
+                1 / 24,
+                out,
+            )
             frames.append(out.copy())
         runs.append(np.array(frames))
     assert runs[0].tobytes() == runs[1].tobytes()
@@ -207,7 +262,9 @@ def test_saved_state_continues_exactly():
     fresh_out = np.zeros_like(out)
     for frame in range(10):
         matrices[0, 12] = 0.2 * frame
-        camera = np.array([3.0 * np.cos(frame), 3.0 * np.sin(frame), 0])  # the view keys' weights change
+        camera = np.array(
+            [3.0 * np.cos(frame), 3.0 * np.sin(frame), 0]
+        )  # the view keys' weights change
         for s, o in ((system, out), (fresh, fresh_out)):
             s.step(matrices, np.eye(4), camera, np.array([0, 0, -9.81]), 1 + frame / 24, 1 / 24, o)
         assert fresh_out.tobytes() == out.tobytes()
@@ -260,12 +317,20 @@ def test_the_substep_rate_does_not_depend_on_the_frame_rate():
 
 
 def _add(system, **overrides):
-    args = dict(parent_bone=0, reference_bone=0, bones=np.array([1, 2], np.int32),
-                offsets=np.array([(0, 0.2, 0), (0, 0.1, 0), (0, 0.1, 0)], float),
-                rest_rotations=np.tile([1.0, 0, 0, 0], (2, 1)), wind=np.zeros(3),
-                key_conditions=np.zeros(1, np.int32), key_directions=np.array([[1.0, 0, 0]]),
-                key_rotations=np.array([[1.0, 0, 0, 0]]), key_speeds=np.zeros(1), key_influences=np.ones(1),
-                key_shapes=np.tile([1.0, 0, 0, 0], (2, 1)))
+    args = dict(
+        parent_bone=0,
+        reference_bone=0,
+        bones=np.array([1, 2], np.int32),
+        offsets=np.array([(0, 0.2, 0), (0, 0.1, 0), (0, 0.1, 0)], float),
+        rest_rotations=np.tile([1.0, 0, 0, 0], (2, 1)),
+        wind=np.zeros(3),
+        key_conditions=np.zeros(1, np.int32),
+        key_directions=np.array([[1.0, 0, 0]]),
+        key_rotations=np.array([[1.0, 0, 0, 0]]),
+        key_speeds=np.zeros(1),
+        key_influences=np.ones(1),
+        key_shapes=np.tile([1.0, 0, 0, 0], (2, 1)),
+    )
     args.update(overrides)
     return system.add_rod(**args)
 
@@ -273,8 +338,15 @@ def _add(system, **overrides):
 @pytest.mark.parametrize(
     "overrides, message",
     [
-        (dict(bones=np.zeros(0, np.int32), offsets=np.zeros((1, 3)), rest_rotations=np.zeros((0, 4)),
-              key_shapes=np.zeros((0, 4))), "at least one joint"),
+        (
+            dict(
+                bones=np.zeros(0, np.int32),
+                offsets=np.zeros((1, 3)),
+                rest_rotations=np.zeros((0, 4)),
+                key_shapes=np.zeros((0, 4)),
+            ),
+            "at least one joint",
+        ),
         (dict(offsets=np.array([(0, 0.2, 0), (0, 0.0, 0), (0, 0.1, 0)], float)), "zero length"),
         (dict(key_shapes=np.array([[np.nan, 0, 0, 0], [1.0, 0, 0, 0]])), "NaN"),
         (dict(key_directions=np.zeros((1, 3))), "zero or NaN direction"),

@@ -1,14 +1,18 @@
 """kodawari_native.view_weights and condition_weights follow the seed's formula exactly."""
 
+import kodawari_native as kn
 import numpy as np
 import pytest
-
-import kodawari_native as kn
 
 
 def seed_formula(directions, influences, view):
     d = view / np.linalg.norm(view)
-    w = np.array([((np.dot(di / np.linalg.norm(di), d) + 1) / 2) ** p for di, p in zip(directions, influences)])
+    w = np.array(
+        [
+            ((np.dot(di / np.linalg.norm(di), d) + 1) / 2) ** p
+            for di, p in zip(directions, influences)
+        ]
+    )
     s = w.sum()
     if s >= 1:
         w = w / s
@@ -25,7 +29,9 @@ def test_view_weights_match_the_formula_on_random_inputs(m):
         view = rng.normal(size=3)
         w = kn.view_weights(directions, influences, view)
         assert w.dtype == np.float64 and w.shape == (m + 1,)
-        np.testing.assert_allclose(w, seed_formula(directions, influences, view), rtol=1e-12, atol=1e-14)
+        np.testing.assert_allclose(
+            w, seed_formula(directions, influences, view), rtol=1e-12, atol=1e-14
+        )
         assert w.sum() == pytest.approx(1.0, abs=1e-12)
         assert (w >= 0).all()
 
@@ -41,7 +47,9 @@ def test_a_key_facing_away_leaves_the_base_shape_at_full_weight():
 
 
 def test_on_a_key_direction_that_key_takes_everything():
-    w = kn.view_weights(np.array([[1.0, 0, 0], [0, 1.0, 0]]), np.array([2.0, 2.0]), np.array([3.0, 0, 0]))
+    w = kn.view_weights(
+        np.array([[1.0, 0, 0], [0, 1.0, 0]]), np.array([2.0, 2.0]), np.array([3.0, 0, 0])
+    )
     # Key 0 has weight 1 and key 1 weight 0.5^2: the sum exceeds 1, so both are normalised.
     np.testing.assert_allclose(w, [0.0, 1 / 1.25, 0.25 / 1.25])
 
@@ -49,7 +57,7 @@ def test_on_a_key_direction_that_key_takes_everything():
 def test_condition_weights_are_the_same_formula():
     s = np.array([0.2, 0.9, 1.0])
     p = np.array([1.0, 3.0, 0.5])
-    w = s ** p
+    w = s**p
     w = w / w.sum()
     np.testing.assert_allclose(kn.condition_weights(s, p), np.concatenate([[0.0], w]))
 

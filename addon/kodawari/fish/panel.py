@@ -93,9 +93,9 @@ class KODAWARI_PT_swim(_SwimPanel, bpy.types.Panel):
             col.label(text=iface_("Baked to {}").format(iface_(target)), icon="CHECKMARK", translate=False)
             if settings.baked == "MESH_CACHE":
                 col.label(text=settings.cache_path, icon="FILE_CACHE", translate=False)
-            row = layout.row(align=True)
-            row.operator("kodawari.swim_free_bake", icon="TRASH")
-            row.operator("kodawari.swim_remove", icon="X")
+            col = layout.column(align=True)  # stacked: side by side, "Remove Fish Swim" is cut off
+            col.operator("kodawari.swim_free_bake", icon="TRASH")
+            col.operator("kodawari.swim_remove", icon="X")
             return
         problem = problems.message(obj, "swim")
         if problem:

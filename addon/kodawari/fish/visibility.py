@@ -17,6 +17,13 @@ def visible(obj):
     return settings.show_render if _rendering[0] else settings.enabled
 
 
+def renders(obj):
+    """True when a render would show this object swimming live (so a farm bake must bake it)."""
+    keys = obj.data.shape_keys
+    has_swim = keys is not None and keys.key_blocks.get(SHAPE_KEY) is not None
+    return has_swim and obj.kodawari_swim.baked == "NONE" and obj.kodawari_swim.show_render
+
+
 def sync(obj):
     """Mute the swim's shape key when the swim is hidden in the current context."""
     keys = obj.data.shape_keys

@@ -7,7 +7,11 @@ from . import handlers, ops, panel, props
 
 CLASSES = props.CLASSES + ops.CLASSES + panel.CLASSES
 PROPERTIES = (
-    (bpy.types.Object, "kodawari_hair", lambda: bpy.props.PointerProperty(type=props.KodawariHairSettings)),
+    (
+        bpy.types.Object,
+        "kodawari_hair",
+        lambda: bpy.props.PointerProperty(type=props.KodawariHairSettings),
+    ),
 )
 HANDLERS = (
     ("frame_change_post", handlers.on_frame_change),

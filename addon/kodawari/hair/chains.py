@@ -23,8 +23,10 @@ def chain_from(bone):
         if not children:
             return chain
         if len(children) > 1:
-            raise ChainError(f"Bone '{tip.name}' has {len(children)} children: a rod must be an unbranched chain "
-                             f"(select the bones after the branch instead)")
+            raise ChainError(
+                f"Bone '{tip.name}' has {len(children)} children: a rod must be an unbranched chain "
+                f"(select the bones after the branch instead)"
+            )
         chain.append(children[0])
 
 
@@ -64,14 +66,20 @@ def resolve_rod(armature_object, rod):
             except (AttributeError, RuntimeError):  # a context that may not write IDs (drawing)
                 pass
     if root is None:
-        raise ChainError(f"Rod '{rod.root_bone}' has 0 joints: its root bone is missing from the armature")
+        raise ChainError(
+            f"Rod '{rod.root_bone}' has 0 joints: its root bone is missing from the armature"
+        )
     if root.parent is None:
-        raise ChainError(f"Bone '{root.name}' has no parent to attach to: a rod hangs from a kinematic bone")
+        raise ChainError(
+            f"Bone '{root.name}' has no parent to attach to: a rod hangs from a kinematic bone"
+        )
     reference = root.parent
     if rod.reference_bone:
         reference = bones.get(rod.reference_bone)
         if reference is None:
-            raise ChainError(f"Reference bone '{rod.reference_bone}' of rod '{root.name}' is missing")
+            raise ChainError(
+                f"Reference bone '{rod.reference_bone}' of rod '{root.name}' is missing"
+            )
     return root.parent, reference, chain_from(root)
 
 

@@ -42,10 +42,10 @@ def resample(polyline, start, lengths):
             qa, qb, qc = d.dot(d), 2 * f.dot(d), f.dot(f) - length * length
             disc = qb * qb - 4 * qa * qc
             if qa > 1e-18 and disc >= 0:
-                t = (-qb + disc ** 0.5) / (2 * qa)
+                t = (-qb + disc**0.5) / (2 * qa)
                 if 0.0 <= t <= 1.0:
                     found = a + d * t
-                    polyline = [found] + polyline[segment + 1:]
+                    polyline = [found] + polyline[segment + 1 :]
                     segment = 0
                     break
             segment += 1

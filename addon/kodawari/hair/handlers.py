@@ -18,7 +18,9 @@ def on_load(filepath=None):
     for obj in bpy.data.objects:
         if obj.type == "ARMATURE" and len(obj.kodawari_hair.rods):
             try:
-                for rod in obj.kodawari_hair.rods:  # rods from before roots were tagged: tag them now
+                for (
+                    rod
+                ) in obj.kodawari_hair.rods:  # rods from before roots were tagged: tag them now
                     if not rod.uid and rod.root_bone in obj.pose.bones:
                         chains.tag_root(obj.pose.bones[rod.root_bone], rod)
                 runtime.restore_state(obj)

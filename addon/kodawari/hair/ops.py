@@ -32,7 +32,9 @@ def _rod(obj, index):
         raise _Refusal("This armature has no rods: add one with Add Rod (kodawari.rod_add)")
     i = settings.active_rod if index < 0 else index
     if i >= len(settings.rods):
-        raise _Refusal(f"Rod index {i} is out of range (the armature has {len(settings.rods)} rods)")
+        raise _Refusal(
+            f"Rod index {i} is out of range (the armature has {len(settings.rods)} rods)"
+        )
     return i, settings.rods[i]
 
 
@@ -49,10 +51,15 @@ def _pose_shape(chain):
     """The chain's current pose as per-joint rotations; refuses NaN or zero quaternions."""
     shape = []
     for pb in chain:
-        q = tuple(pb.rotation_quaternion) if pb.rotation_mode == "QUATERNION" else \
-            tuple(pb.matrix_basis.to_quaternion())
+        q = (
+            tuple(pb.rotation_quaternion)
+            if pb.rotation_mode == "QUATERNION"
+            else tuple(pb.matrix_basis.to_quaternion())
+        )
         if not chains.finite_quaternions(q):
-            raise _Refusal(f"Bone '{pb.name}' has an invalid rotation (NaN or zero): fix the pose before keying")
+            raise _Refusal(
+                f"Bone '{pb.name}' has an invalid rotation (NaN or zero): fix the pose before keying"
+            )
         n = math.sqrt(sum(c * c for c in q))
         shape.append(tuple(c / n for c in q))
     return shape
@@ -136,7 +143,9 @@ class KODAWARI_OT_rod_add(_HairOperator, bpy.types.Operator):
         plans = []
         for root in roots:
             if root.parent is None:
-                raise _Refusal(f"Bone '{root.name}' has no parent to attach to: a rod hangs from a kinematic bone")
+                raise _Refusal(
+                    f"Bone '{root.name}' has no parent to attach to: a rod hangs from a kinematic bone"
+                )
             try:
                 chain = chains.chain_from(root)
             except chains.ChainError as exc:
@@ -149,7 +158,9 @@ class KODAWARI_OT_rod_add(_HairOperator, bpy.types.Operator):
         settings = obj.kodawari_hair
         for root, chain in plans:
             rod = settings.rods.add()
-            rod.root_bone = root.name  # tags the root bone with the rod's identity (props._root_changed)
+            rod.root_bone = (
+                root.name
+            )  # tags the root bone with the rod's identity (props._root_changed)
             for bone in chain:
                 pb = obj.pose.bones[bone.name]
                 if pb.rotation_mode != "QUATERNION":
@@ -170,7 +181,9 @@ class KODAWARI_OT_rod_remove(_HairOperator, bpy.types.Operator):
     bl_idname = "kodawari.rod_remove"
     bl_label = "Remove Rod"
     bl_options = {"REGISTER", "UNDO"}
-    rod_index: bpy.props.IntProperty(name="Rod", default=-1, description="Which rod (-1: the active one)")
+    rod_index: bpy.props.IntProperty(
+        name="Rod", default=-1, description="Which rod (-1: the active one)"
+    )
 
     def run(self, context):
         obj = _armature(context)
@@ -191,13 +204,24 @@ class KODAWARI_OT_rod_key_view(_HairOperator, bpy.types.Operator):
     bl_label = "Key View"
     bl_options = {"REGISTER", "UNDO"}
     source: bpy.props.EnumProperty(
-        name="Source", default="CAMERA",
-        items=(("CAMERA", "Camera", "Look through the scene's active camera"),
-               ("VIEWPORT", "Viewport", "The 3D viewport's view")),
-        description="Which view to key the shape for")
-    influence: bpy.props.FloatProperty(name="Influence", default=props.DEFAULT_INFLUENCE, min=0.01, soft_max=64.0,
-                                       description="How narrowly the shape applies (the default: half strength 60° away)")
-    rod_index: bpy.props.IntProperty(name="Rod", default=-1, description="Which rod (-1: the active one)")
+        name="Source",
+        default="CAMERA",
+        items=(
+            ("CAMERA", "Camera", "Look through the scene's active camera"),
+            ("VIEWPORT", "Viewport", "The 3D viewport's view"),
+        ),
+        description="Which view to key the shape for",
+    )
+    influence: bpy.props.FloatProperty(
+        name="Influence",
+        default=props.DEFAULT_INFLUENCE,
+        min=0.01,
+        soft_max=64.0,
+        description="How narrowly the shape applies (the default: half strength 60° away)",
+    )
+    rod_index: bpy.props.IntProperty(
+        name="Rod", default=-1, description="Which rod (-1: the active one)"
+    )
 
     def run(self, context):
         obj = _armature(context)
@@ -220,7 +244,9 @@ def view_direction(obj, reference, eye_world):
     rotation = reference.matrix.to_quaternion()
     d = rotation.inverted() @ (eye - reference.matrix.translation)
     if d.length < 1e-6:
-        raise _Refusal(f"The camera is at the reference bone '{reference.name}': the view direction is undefined")
+        raise _Refusal(
+            f"The camera is at the reference bone '{reference.name}': the view direction is undefined"
+        )
     return d.normalized()
 
 
@@ -230,9 +256,16 @@ class KODAWARI_OT_rod_key_pose(_HairOperator, bpy.types.Operator):
     bl_idname = "kodawari.rod_key_pose"
     bl_label = "Key Pose"
     bl_options = {"REGISTER", "UNDO"}
-    influence: bpy.props.FloatProperty(name="Influence", default=props.DEFAULT_INFLUENCE, min=0.01, soft_max=64.0,
-                                       description="How narrowly the shape applies (the default: half strength 60° away)")
-    rod_index: bpy.props.IntProperty(name="Rod", default=-1, description="Which rod (-1: the active one)")
+    influence: bpy.props.FloatProperty(
+        name="Influence",
+        default=props.DEFAULT_INFLUENCE,
+        min=0.01,
+        soft_max=64.0,
+        description="How narrowly the shape applies (the default: half strength 60° away)",
+    )
+    rod_index: bpy.props.IntProperty(
+        name="Rod", default=-1, description="Which rod (-1: the active one)"
+    )
 
     def run(self, context):
         obj = _armature(context)
@@ -256,11 +289,23 @@ class KODAWARI_OT_rod_key_speed(_HairOperator, bpy.types.Operator):
     bl_idname = "kodawari.rod_key_speed"
     bl_label = "Key Speed"
     bl_options = {"REGISTER", "UNDO"}
-    speed: bpy.props.FloatProperty(name="Speed", default=2.0, min=0.0, unit="VELOCITY",
-                                   description="The reference bone's speed (m/s) at which this shape applies")
-    influence: bpy.props.FloatProperty(name="Influence", default=props.DEFAULT_INFLUENCE, min=0.01, soft_max=64.0,
-                                       description="How narrowly the shape applies (the default: half strength 60° away)")
-    rod_index: bpy.props.IntProperty(name="Rod", default=-1, description="Which rod (-1: the active one)")
+    speed: bpy.props.FloatProperty(
+        name="Speed",
+        default=2.0,
+        min=0.0,
+        unit="VELOCITY",
+        description="The reference bone's speed (m/s) at which this shape applies",
+    )
+    influence: bpy.props.FloatProperty(
+        name="Influence",
+        default=props.DEFAULT_INFLUENCE,
+        min=0.01,
+        soft_max=64.0,
+        description="How narrowly the shape applies (the default: half strength 60° away)",
+    )
+    rod_index: bpy.props.IntProperty(
+        name="Rod", default=-1, description="Which rod (-1: the active one)"
+    )
 
     def run(self, context):
         obj = _armature(context)
@@ -290,8 +335,12 @@ class KODAWARI_OT_rod_key_preview(_HairOperator, bpy.types.Operator):
     bl_idname = "kodawari.rod_key_preview"
     bl_label = "Preview Key"
     bl_options = {"REGISTER", "UNDO"}
-    rod_index: bpy.props.IntProperty(name="Rod", default=-1, description="Which rod (-1: the active one)")
-    key_index: bpy.props.IntProperty(name="Key", default=-1, description="Which key (-1: the active one)")
+    rod_index: bpy.props.IntProperty(
+        name="Rod", default=-1, description="Which rod (-1: the active one)"
+    )
+    key_index: bpy.props.IntProperty(
+        name="Key", default=-1, description="Which key (-1: the active one)"
+    )
 
     def run(self, context):
         obj = _armature(context)
@@ -299,7 +348,9 @@ class KODAWARI_OT_rod_key_preview(_HairOperator, bpy.types.Operator):
         _, key = _key(rod, self.key_index)
         _, _, chain = _chain_pose_bones(obj, rod)
         if len(key.shape) != len(chain):
-            raise _Refusal(f"Key '{key.name}' has {len(key.shape)} joints, the chain has {len(chain)}: re-key it")
+            raise _Refusal(
+                f"Key '{key.name}' has {len(key.shape)} joints, the chain has {len(chain)}: re-key it"
+            )
         for pb, joint in zip(chain, key.shape):
             pb.rotation_mode = "QUATERNION"
             pb.rotation_quaternion = joint.rotation
@@ -313,8 +364,12 @@ class KODAWARI_OT_rod_rekey(_HairOperator, bpy.types.Operator):
     bl_idname = "kodawari.rod_rekey"
     bl_label = "Re-key"
     bl_options = {"REGISTER", "UNDO"}
-    rod_index: bpy.props.IntProperty(name="Rod", default=-1, description="Which rod (-1: the active one)")
-    key_index: bpy.props.IntProperty(name="Key", default=-1, description="Which key (-1: the active one)")
+    rod_index: bpy.props.IntProperty(
+        name="Rod", default=-1, description="Which rod (-1: the active one)"
+    )
+    key_index: bpy.props.IntProperty(
+        name="Key", default=-1, description="Which key (-1: the active one)"
+    )
 
     def run(self, context):
         obj = _armature(context)
@@ -336,8 +391,12 @@ class KODAWARI_OT_rod_key_remove(_HairOperator, bpy.types.Operator):
     bl_idname = "kodawari.rod_key_remove"
     bl_label = "Delete Key"
     bl_options = {"REGISTER", "UNDO"}
-    rod_index: bpy.props.IntProperty(name="Rod", default=-1, description="Which rod (-1: the active one)")
-    key_index: bpy.props.IntProperty(name="Key", default=-1, description="Which key (-1: the active one)")
+    rod_index: bpy.props.IntProperty(
+        name="Rod", default=-1, description="Which rod (-1: the active one)"
+    )
+    key_index: bpy.props.IntProperty(
+        name="Key", default=-1, description="Which key (-1: the active one)"
+    )
 
     def run(self, context):
         obj = _armature(context)
@@ -358,21 +417,45 @@ class KODAWARI_OT_rod_collider_add(_HairOperator, bpy.types.Operator):
     bl_label = "Add Collider"
     bl_options = {"REGISTER", "UNDO"}
     bone: bpy.props.StringProperty(name="Bone", description="Empty: the active bone")
-    shape: bpy.props.EnumProperty(name="Shape", items=(("SPHERE", "Sphere", "A ball around a point"),
-                                                       ("CAPSULE", "Capsule", "A rounded cylinder along the bone")),
-                                  description="Shape the hair cannot enter")
-    radius: bpy.props.FloatProperty(name="Radius", default=0.1, min=0.0, unit="LENGTH", subtype="DISTANCE",
-                                    description="Size of the collider")
-    length: bpy.props.FloatProperty(name="Length", default=0.2, min=0.0, unit="LENGTH", subtype="DISTANCE",
-                                    description="Capsule: how far it reaches along the bone")
-    offset: bpy.props.FloatVectorProperty(name="Offset", size=3, unit="LENGTH", subtype="TRANSLATION",
-                                          description="Where the collider sits, relative to the bone")
+    shape: bpy.props.EnumProperty(
+        name="Shape",
+        items=(
+            ("SPHERE", "Sphere", "A ball around a point"),
+            ("CAPSULE", "Capsule", "A rounded cylinder along the bone"),
+        ),
+        description="Shape the hair cannot enter",
+    )
+    radius: bpy.props.FloatProperty(
+        name="Radius",
+        default=0.1,
+        min=0.0,
+        unit="LENGTH",
+        subtype="DISTANCE",
+        description="Size of the collider",
+    )
+    length: bpy.props.FloatProperty(
+        name="Length",
+        default=0.2,
+        min=0.0,
+        unit="LENGTH",
+        subtype="DISTANCE",
+        description="Capsule: how far it reaches along the bone",
+    )
+    offset: bpy.props.FloatVectorProperty(
+        name="Offset",
+        size=3,
+        unit="LENGTH",
+        subtype="TRANSLATION",
+        description="Where the collider sits, relative to the bone",
+    )
 
     def run(self, context):
         obj = _armature(context)
         name = self.bone or (obj.data.bones.active.name if obj.data.bones.active else "")
         if not name or name not in obj.data.bones:
-            raise _Refusal(f"Bone '{name}' is not in the armature: pick the bone the collider follows")
+            raise _Refusal(
+                f"Bone '{name}' is not in the armature: pick the bone the collider follows"
+            )
         collider = obj.kodawari_hair.colliders.add()
         collider.bone, collider.shape, collider.radius = name, self.shape, self.radius
         collider.length, collider.offset = self.length, self.offset
@@ -406,11 +489,17 @@ class KODAWARI_OT_rod_fit_stroke(_HairOperator, bpy.types.Operator):
     bl_label = "Fit to Stroke"
     bl_options = {"REGISTER", "UNDO"}
     source: bpy.props.EnumProperty(
-        name="View", default="CAMERA",
-        items=(("CAMERA", "Camera", "As seen through the active camera"),
-               ("VIEWPORT", "Viewport", "As seen in the 3D viewport")),
-        description="Which view the stroke was drawn in")
-    rod_index: bpy.props.IntProperty(name="Rod", default=-1, description="Which rod (-1: the active one)")
+        name="View",
+        default="CAMERA",
+        items=(
+            ("CAMERA", "Camera", "As seen through the active camera"),
+            ("VIEWPORT", "Viewport", "As seen in the 3D viewport"),
+        ),
+        description="Which view the stroke was drawn in",
+    )
+    rod_index: bpy.props.IntProperty(
+        name="Rod", default=-1, description="Which rod (-1: the active one)"
+    )
 
     def invoke(self, context, event):
         if _viewport_eye(context) is not None:
@@ -425,10 +514,14 @@ class KODAWARI_OT_rod_fit_stroke(_HairOperator, bpy.types.Operator):
         parent, _, chain = _chain_pose_bones(obj, rod)
         points, origin = strokes.find_stroke(context, exclude=obj)
         if not points or len(points) < 2:
-            raise _Refusal("No stroke to fit: draw an annotation (or grease-pencil) stroke of two or more points")
+            raise _Refusal(
+                "No stroke to fit: draw an annotation (or grease-pencil) stroke of two or more points"
+            )
         eye, forward, perspective = _eye(context, self.source)
         try:
-            rotations = fitting.fit_chain_to_stroke(obj, parent, chain, points, eye, forward, perspective)
+            rotations = fitting.fit_chain_to_stroke(
+                obj, parent, chain, points, eye, forward, perspective
+            )
         except fitting.FitError as exc:
             raise _Refusal(str(exc)) from None
         for pb, q in zip(chain, rotations):
@@ -444,8 +537,11 @@ class KODAWARI_OT_rod_bake(BakeOperator, bpy.types.Operator):
     bl_idname = "kodawari.rod_bake"
     bl_label = "Bake Hair"
     bl_options = {"REGISTER", "UNDO"}
-    new_action: bpy.props.BoolProperty(name="New Action in NLA", default=False,
-                                       description="Bake into a new action pushed to an NLA track")
+    new_action: bpy.props.BoolProperty(
+        name="New Action in NLA",
+        default=False,
+        description="Bake into a new action pushed to an NLA track",
+    )
 
     def make_job(self, context):
         try:
@@ -457,7 +553,16 @@ class KODAWARI_OT_rod_bake(BakeOperator, bpy.types.Operator):
 
 
 CLASSES = (
-    KODAWARI_OT_rod_add, KODAWARI_OT_rod_remove, KODAWARI_OT_rod_key_view, KODAWARI_OT_rod_key_pose,
-    KODAWARI_OT_rod_key_speed, KODAWARI_OT_rod_key_preview, KODAWARI_OT_rod_rekey, KODAWARI_OT_rod_key_remove,
-    KODAWARI_OT_rod_collider_add, KODAWARI_OT_rod_collider_remove, KODAWARI_OT_rod_fit_stroke, KODAWARI_OT_rod_bake,
+    KODAWARI_OT_rod_add,
+    KODAWARI_OT_rod_remove,
+    KODAWARI_OT_rod_key_view,
+    KODAWARI_OT_rod_key_pose,
+    KODAWARI_OT_rod_key_speed,
+    KODAWARI_OT_rod_key_preview,
+    KODAWARI_OT_rod_rekey,
+    KODAWARI_OT_rod_key_remove,
+    KODAWARI_OT_rod_collider_add,
+    KODAWARI_OT_rod_collider_remove,
+    KODAWARI_OT_rod_fit_stroke,
+    KODAWARI_OT_rod_bake,
 )

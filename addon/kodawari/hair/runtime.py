@@ -38,7 +38,9 @@ def cache_budget_bytes():
     from ..preferences import addon_package
 
     addon = bpy.context.preferences.addons.get(addon_package())
-    megabytes = getattr(getattr(addon, "preferences", None), "hair_cache_megabytes", DEFAULT_CACHE_MEGABYTES)
+    megabytes = getattr(
+        getattr(addon, "preferences", None), "hair_cache_megabytes", DEFAULT_CACHE_MEGABYTES
+    )
     return int(megabytes) << 20
 
 
@@ -92,21 +94,38 @@ class ArmatureRuntime:
                 shapes = np.zeros((m, n, 4))
                 for j, key in enumerate(rod.keys):
                     if len(key.shape) != n:
-                        raise chains.ChainError(f"Key '{key.name}' of rod '{rod.root_bone}' has {len(key.shape)} "
-                                                f"joints, the chain has {n}: re-key it")
+                        raise chains.ChainError(
+                            f"Key '{key.name}' of rod '{rod.root_bone}' has {len(key.shape)} "
+                            f"joints, the chain has {n}: re-key it"
+                        )
                     for k, joint in enumerate(key.shape):
                         shapes[j, k] = joint.rotation
                 slot = self.system.add_rod(
-                    index[parent.name], index[reference.name], np.array([index[b.name] for b in chain], np.int32),
-                    offsets, rest, stiffness=rod.stiffness, damping=rod.damping, gravity=rod.gravity,
-                    substeps=rod.substeps, iterations=rod.iterations, radius=rod.radius,
+                    index[parent.name],
+                    index[reference.name],
+                    np.array([index[b.name] for b in chain], np.int32),
+                    offsets,
+                    rest,
+                    stiffness=rod.stiffness,
+                    damping=rod.damping,
+                    gravity=rod.gravity,
+                    substeps=rod.substeps,
+                    iterations=rod.iterations,
+                    radius=rod.radius,
                     wind=np.array(rod.wind, np.float64),
-                    key_conditions=np.array([props.CONDITION_CODES[k.condition] for k in rod.keys], np.int32),
-                    key_directions=np.array([tuple(k.direction) for k in rod.keys], np.float64).reshape(m, 3),
-                    key_rotations=np.array([tuple(k.rotation) for k in rod.keys], np.float64).reshape(m, 4),
+                    key_conditions=np.array(
+                        [props.CONDITION_CODES[k.condition] for k in rod.keys], np.int32
+                    ),
+                    key_directions=np.array(
+                        [tuple(k.direction) for k in rod.keys], np.float64
+                    ).reshape(m, 3),
+                    key_rotations=np.array(
+                        [tuple(k.rotation) for k in rod.keys], np.float64
+                    ).reshape(m, 4),
                     key_speeds=np.array([k.speed for k in rod.keys], np.float64),
                     key_influences=np.array([k.influence for k in rod.keys], np.float64),
-                    key_shapes=shapes.reshape(m * n, 4))
+                    key_shapes=shapes.reshape(m * n, 4),
+                )
             except ValueError as exc:  # ChainError is a ValueError, as are the solver's refusals
                 errors.append(str(exc))
                 continue
@@ -114,13 +133,18 @@ class ArmatureRuntime:
             self.rod_chains[i] = [b.name for b in chain]
             rod_bones.extend(index[b.name] for b in chain)
         colliders = [c for c in settings.colliders if c.bone in index]
-        errors.extend(f"Collider bone '{c.bone}' is missing" for c in settings.colliders if c.bone not in index)
+        errors.extend(
+            f"Collider bone '{c.bone}' is missing"
+            for c in settings.colliders
+            if c.bone not in index
+        )
         self.system.set_colliders(
             np.array([index[c.bone] for c in colliders], np.int32),
             np.array([1 if c.shape == "CAPSULE" else 0 for c in colliders], np.int32),
             np.array([tuple(c.offset) for c in colliders], np.float64).reshape(-1, 3),
             np.array([c.radius for c in colliders], np.float64),
-            np.array([c.length for c in colliders], np.float64))
+            np.array([c.length for c in colliders], np.float64),
+        )
         self.error = "; ".join(errors)
         self.status = ""
         self.rod_bones = np.array(rod_bones, dtype=np.int64)
@@ -135,7 +159,9 @@ class ArmatureRuntime:
                 parent, reference, _chain = chains.resolve_rod(obj, rod)
                 read.update((index[parent.name], index[reference.name]))
         read.update(index[c.bone] for c in colliders)
-        self.matrix_bones = sorted(read) if len(read) * SPARSE_READ_RATIO <= self.bone_count else None
+        self.matrix_bones = (
+            sorted(read) if len(read) * SPARSE_READ_RATIO <= self.bone_count else None
+        )
         others = sorted(set(range(self.bone_count)) - set(rod_bones))
         self.other_bones = others if len(others) * SPARSE_READ_RATIO <= self.bone_count else None
         self.last_frame = None
@@ -147,8 +173,24 @@ class ArmatureRuntime:
             return
         for i in self.matrix_bones:
             m = pose_bones[i].matrix  # row-major; the solver takes foreach_get's column-major rows
-            self.matrices[i] = (m[0][0], m[1][0], m[2][0], m[3][0], m[0][1], m[1][1], m[2][1], m[3][1],
-                                m[0][2], m[1][2], m[2][2], m[3][2], m[0][3], m[1][3], m[2][3], m[3][3])
+            self.matrices[i] = (
+                m[0][0],
+                m[1][0],
+                m[2][0],
+                m[3][0],
+                m[0][1],
+                m[1][1],
+                m[2][1],
+                m[3][1],
+                m[0][2],
+                m[1][2],
+                m[2][2],
+                m[3][2],
+                m[0][3],
+                m[1][3],
+                m[2][3],
+                m[3][3],
+            )
 
     def _read_other_rotations(self, pose_bones):
         """The current rotations of the bones the solver does not write (foreach_set writes all)."""
@@ -167,7 +209,9 @@ class ArmatureRuntime:
         self.status = "" if camera is not None else NO_CAMERA
         camera_position = None
         if camera is not None:
-            camera_position = np.array(_evaluated(camera, depsgraph).matrix_world.translation, np.float64)
+            camera_position = np.array(
+                _evaluated(camera, depsgraph).matrix_world.translation, np.float64
+            )
         gravity = np.array(scene.gravity if scene.use_gravity else (0.0, 0.0, 0.0), np.float64)
         armature_matrix = np.array([tuple(row) for row in evaluated.matrix_world], np.float64)
         return armature_matrix, camera_position, gravity
@@ -203,7 +247,11 @@ class ArmatureRuntime:
             previous = self.last_frame
         else:
             previous = self.system.latest_cached_frame_before(frame)
-        if frame > scene.frame_start and (previous is None or previous < frame - 1) and _can_replay(depsgraph):
+        if (
+            frame > scene.frame_start
+            and (previous is None or previous < frame - 1)
+            and _can_replay(depsgraph)
+        ):
             # A jump past the cached frames (or to a dropped one): play the frames in between
             # as playback would, each evaluated by Blender and simulated by this handler.
             _replay(scene, scene.frame_start if previous is None else previous + 1, frame)
@@ -212,12 +260,21 @@ class ArmatureRuntime:
         armature_matrix, camera, gravity = self._inputs(obj, scene, frame, depsgraph)
         if frame <= scene.frame_start or previous is None:
             self.system.clear_cache()
-            self.system.reset(self.matrices, armature_matrix, camera, gravity, frame / fps, self.rotations)
+            self.system.reset(
+                self.matrices, armature_matrix, camera, gravity, frame / fps, self.rotations
+            )
         else:
             if self.last_frame != previous:
                 self.system.recall_frame(previous)
-            self.system.step(self.matrices, armature_matrix, camera, gravity, frame / fps,
-                             (frame - previous) / fps, self.rotations)
+            self.system.step(
+                self.matrices,
+                armature_matrix,
+                camera,
+                gravity,
+                frame / fps,
+                (frame - previous) / fps,
+                self.rotations,
+            )
         self.system.store_frame(frame, self.rotations)
         self.last_frame = frame
         self._write(obj)
@@ -296,7 +353,10 @@ def evaluate_scene(scene, depsgraph=None):
             if rt is not None:
                 rt.status = f"Hair not simulated: {problems.message(obj, 'hair')}"
         else:
-            problems.clear(obj, "hair")
+            if rt.error:  # a rod could not be built (its bones deleted or renamed): say so, once
+                problems.report(obj, "hair", ValueError(rt.error))
+            else:
+                problems.clear(obj, "hair")
 
 
 def store_state(obj):

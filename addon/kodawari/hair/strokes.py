@@ -15,7 +15,9 @@ def _frame_at(layer, frame_number):
         return None
     best = None
     for frame in frames:
-        if frame.frame_number <= frame_number and (best is None or frame.frame_number >= best.frame_number):
+        if frame.frame_number <= frame_number and (
+            best is None or frame.frame_number >= best.frame_number
+        ):
             best = frame
     return best or frames[0]
 
@@ -54,7 +56,11 @@ def find_stroke(context, exclude=None):
         points = _last_stroke_points(annotation, scene.frame_current)
         if points:
             return points, f"annotation '{annotation.name}'"
-    candidates = [o for o in context.selected_objects if o is not exclude] if context.selected_objects else []
+    candidates = (
+        [o for o in context.selected_objects if o is not exclude]
+        if context.selected_objects
+        else []
+    )
     candidates += [o for o in scene.objects if o not in candidates and o is not exclude]
     for obj in candidates:
         if obj.type not in {"GPENCIL", "GREASEPENCIL"}:

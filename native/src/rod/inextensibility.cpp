@@ -10,28 +10,22 @@ namespace {
 // Relative length error at which the Newton steps stop: what is left is closed by the
 // joint-by-joint pass in rod_simulate.cpp, which then moves joints by micrometres.
 constexpr Real kConverged = 1e-5;
+// Relative length error beyond which the Gauss-Seidel sweeps run before the Newton steps.
+constexpr Real kFar = 1e-3;
 }  // namespace
 
-Real project_chain_lengths(Vec3* x, std::size_t count, const Real* lengths, const Real* inverse_mass,
+bool project_chain_lengths(Vec3* x, std::size_t count, const Real* lengths, const Real* inverse_mass,
                            Real* scratch, int newton_steps, int sweeps) {
-  if (count < 2) return 0;
+  if (count < 2) return true;
   const std::size_t m = count - 1;  // constraints
   Real* diag = scratch;             // S_kk, then the Thomas pivots
   Real* upper = scratch + m;        // S_k,k+1
   Real* rhs = scratch + 2 * m;      // -C_k, then lambda_k
   Real* normals = scratch + 3 * m;  // n_k (3 per constraint) of the linearisation point
-  // Far from the manifold (a fast tip moves bones' lengths per substep on long chains) a
-  // linearisation means little: Gauss-Seidel sweeps of the same mass-weighted distance
-  // projection (PBD, each an exact local projection) bring the chain close first.
-  for (int sweep = 0; sweep < sweeps; ++sweep) {
-    for (std::size_t k = 0; k < m; ++k) project_distance(x[k], x[k + 1], inverse_mass[k], inverse_mass[k + 1], lengths[k]);
-    for (std::size_t k = m; k-- > 0;) project_distance(x[k], x[k + 1], inverse_mass[k], inverse_mass[k + 1], lengths[k]);
-  }
-  Real worst = 0;
   for (int step = 0; step < newton_steps; ++step) {
     // S = J M^-1 J^T (tridiagonal) and -C. Segment k joins x[k] (gradient -n_k) and x[k+1]
     // (+n_k); segments k and k+1 share x[k+1]: S_k,k+1 = -w_{k+1} n_k . n_{k+1}.
-    worst = 0;
+    Real worst = 0;
     for (std::size_t k = 0; k < m; ++k) {
       const Vec3 d = x[k + 1] - x[k];
       const Real len = d.norm();
@@ -48,7 +42,19 @@ Real project_chain_lengths(Vec3* x, std::size_t count, const Real* lengths, cons
       const Real error = std::abs(rhs[k]) / lengths[k];
       if (error > worst) worst = error;
     }
-    if (worst < kConverged) break;
+    if (worst < kConverged) return true;
+    if (worst > kFar && sweeps > 0) {
+      // Far from the manifold (a fast tip moves bones' lengths per substep on long chains)
+      // a linearisation means little: Gauss-Seidel sweeps of the same mass-weighted distance
+      // projection (PBD, each an exact local projection) bring the chain close first.
+      for (int sweep = 0; sweep < sweeps; ++sweep) {
+        for (std::size_t k = 0; k < m; ++k) project_distance(x[k], x[k + 1], inverse_mass[k], inverse_mass[k + 1], lengths[k]);
+        for (std::size_t k = m; k-- > 0;) project_distance(x[k], x[k + 1], inverse_mass[k], inverse_mass[k + 1], lengths[k]);
+      }
+      sweeps = 0;
+      --step;  // the sweeps do not count as a Newton step
+      continue;
+    }
     // Thomas algorithm (S is symmetric positive definite: no pivoting needed).
     for (std::size_t k = 1; k < m; ++k) {
       if (!(diag[k - 1] > 0)) continue;
@@ -68,7 +74,7 @@ Real project_chain_lengths(Vec3* x, std::size_t count, const Real* lengths, cons
       x[k + 1] += inverse_mass[k + 1] * push;
     }
   }
-  return worst;
+  return false;
 }
 
 }  // namespace kodawari::rod

@@ -122,9 +122,9 @@ void RodSystem::simulate(std::size_t r, const FrameInput& input, const std::vect
   const Vec3 gravity = world_to_armature * (input.gravity * p.gravity);
   const Real base_dt = 1 / rate;
   const Real min_length = *std::min_element(w.lengths.begin(), w.lengths.end());
-  // How far the root moves per substep: the root's segment must take that up. (The anchor's
-  // turn moves only the ghost behind the root, which the length projection does not see.)
-  const Real anchor_travel = steps > 0 ? (anchor_end - anchor_start).norm() / Real(steps) : Real(0);
+  // The root's velocity over this frame (the kinematic end of the first bone).
+  const Real frame_time = steps > 0 ? Real(steps) * base_dt : Real(1);
+  const Vec3 anchor_velocity = (anchor_end - anchor_start) / frame_time;
 
   w.orientation_terms.resize(count);
   w.orientation_quats.resize(count);
@@ -133,14 +133,22 @@ void RodSystem::simulate(std::size_t r, const FrameInput& input, const std::vect
   Vec3* x = s.x.data();
   Quat* q = s.q.data();
   for (long step = 1; step <= steps; ++step) {
-    // A joint must not travel more than kMaxTravel segments in one substep: beyond that the
-    // projections below no longer see the motion they correct (on long chains of short bones
-    // a whipping tip covers several bones per substep at the base rate). Such substeps are
-    // split; the shape-matching fraction is rescaled so the stiffness per base substep stays.
+    // No joint may move more than kMaxTravel bone lengths relative to the root in one
+    // substep: beyond that the length projection's linearisation no longer sees the motion it
+    // corrects (its corrections add up along the chain: on long chains of short bones a
+    // whipping tip outruns it at the base rate). A chain carried along whole by the root
+    // needs no split. Such substeps are split; the shape-matching fraction is rescaled so
+    // the stiffness per base substep stays.
     Real fastest = 0;
-    for (std::size_t j = 2; j < count; ++j) fastest = std::max(fastest, s.v[j].squaredNorm());
-    const Real travel = (std::sqrt(fastest) + gravity.norm() * base_dt) * base_dt + anchor_travel;
-    const Real split_needed = std::ceil(travel / (kMaxTravel * min_length));
+    for (std::size_t j = 2; j < count; ++j) fastest = std::max(fastest, (s.v[j] - anchor_velocity).squaredNorm());
+    const Real travel = (std::sqrt(fastest) + gravity.norm() * base_dt) * base_dt;
+    // Gravity alone drops every joint by g dt² per substep while the root holds; the
+    // projection lifts them all back through the root's bone, so that drop must stay a
+    // small part of a bone (kMaxDrop; g dt² is 1 mm at the default 96 Hz, 1.7 cm at one
+    // substep per frame).
+    const Real drop = gravity.norm() * base_dt * base_dt;
+    const Real split_needed = std::max(std::ceil(travel / (kMaxTravel * min_length)),
+                                       std::ceil(std::sqrt(drop / (kMaxDrop * min_length))));
     const int split = static_cast<int>(std::clamp(split_needed, Real(1), Real(kMaxSplit)));
     const Real dt = base_dt / Real(split);
     const Real inverse_dt = 1 / dt;
@@ -249,9 +257,11 @@ void RodSystem::simulate(std::size_t r, const FrameInput& input, const std::vect
     // Inextensibility (docs/algorithms.md §3.3 step 3): the mass-weighted
     // projection onto the bone lengths (both ends of every segment move, momentum is kept;
     // rod/inextensibility.hpp), then the collider push-out.
-    project_chain_lengths(x + 1, n + 1, w.lengths.data(), w.inverse_mass.data(), w.projection.data());
+    const bool converged =
+        project_chain_lengths(x + 1, n + 1, w.lengths.data(), w.inverse_mass.data(), w.projection.data());
+    bool pushed = false;
     if (!colliders.empty()) {
-      for (std::size_t j = 2; j < count; ++j) push_out_of_colliders(x[j], colliders, p.radius);
+      for (std::size_t j = 2; j < count; ++j) pushed = push_out_of_colliders(x[j], colliders, p.radius) || pushed;
     }
     // What the projection left (a contact, a step it did not fully converge in) is closed
     // joint by joint from the root, each onto its bone length and out of the colliders, so
@@ -259,7 +269,7 @@ void RodSystem::simulate(std::size_t r, const FrameInput& input, const std::vect
     // "follow the leader" correction passed every correction down to the tip as velocity and
     // pumped energy into chains of ten or more bones (issue 9); here it moves joints by
     // round-off, or only in contact, where the push-out dissipates anyway.
-    for (std::size_t k = 0; k < n; ++k) {
+    for (std::size_t k = 0; k < n && (pushed || !converged); ++k) {
       Vec3& a = x[k + 1];
       Vec3& b = x[k + 2];
       for (int pass = 0; pass < 4; ++pass) {
