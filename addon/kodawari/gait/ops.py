@@ -25,16 +25,14 @@ class KODAWARI_OT_gait_setup(bpy.types.Operator):
     bl_options = {"REGISTER", "UNDO"}
 
     limits: bpy.props.EnumProperty(
-        name="Joint Ranges", default="REST",
+        name="Joint Ranges", default="REST", description="How far each leg joint may bend",
         items=(("REST", "From Rest Pose", "Each joint bends the way it bends at rest, within a range around it"),
-               ("HORSE", "Horse", "A horse's joint ranges for 4-bone legs (other legs: from the rest pose)")),
-        description="Where each joint's bending range comes from")
+               ("HORSE", "Horse", "A horse's joint ranges for 4-bone legs (other legs: from the rest pose)")))
     root_motion: bpy.props.EnumProperty(
-        name="Root Motion", default="AUTO",
+        name="Root Motion", default="AUTO", description="Where the bake keys the animal's travel",
         items=(("AUTO", "Automatic", "The body bone when the legs share one, else the armature object"),
                ("BONE", "Body Bone", "The topmost bone carrying the legs whose location Blender applies"),
-               ("OBJECT", "Armature Object", "The armature object itself")),
-        description="What carries the animal forward: the body bone or the armature object")
+               ("OBJECT", "Armature Object", "The armature object itself")))
 
     def execute(self, context):
         obj = _armature(context)
