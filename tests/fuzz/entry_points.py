@@ -178,6 +178,43 @@ def _set_cache_budget(budget):
     return system.cache_budget, system.cache_bytes, system.cached_frames(), _rod_state(system)
 
 
+def _fin_part_args():
+    heights = np.repeat(np.linspace(0.0, 0.1, 6), 5)
+    along = np.tile(np.linspace(0.0, 0.2, 5), 6)
+    return {
+        "points": np.stack([along, np.zeros_like(along), heights], axis=1).astype(np.float32),
+        "reach": heights.copy(),
+        "weight": np.ones_like(heights),
+        "root": np.array([0.1, 0.0, 0.0]),
+        "outward": np.array([0.0, 0.0, 1.0]),
+        "tangent": np.array([1.0, 0.0, 0.0]),
+        "side": np.array([0.0, 1.0, 0.0]),
+        "up": np.array([0.0, 0.0, 1.0]),
+        "height": 0.1,
+        "base_length": 0.2,
+        "base_front": 0.0,
+    }
+
+
+def _fin_part():
+    return kn.FinPart(**_fin_part_args())
+
+
+def _displace_args():
+    probes = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]], dtype=np.float32)
+    return {
+        "motion": "FLAP",
+        "amplitude": 0.5,
+        "phase": 1.2,
+        "feathering": 0.1,
+        "wavelength": 1.0,
+        "feather_on_power": False,
+        "probes_rest": probes,
+        "probes_now": probes[[0, 2, 1, 3]].copy(),
+        "out": np.zeros((30, 3), np.float32),
+    }
+
+
 def _fin_args():
     return {
         "rest_points": np.column_stack([np.zeros(5), np.linspace(0, 0.4, 5), np.zeros(5)]),
@@ -310,6 +347,17 @@ TARGETS = [
         },
         kn.swim_speed,
     ),
+    Target("FinPart", _fin_part_args, kn.FinPart, examples=80),
+    Target(
+        "FinPart.displace",
+        _displace_args,
+        _method(_fin_part, "displace"),
+        outputs=("out",),
+        examples=80,
+    ),
+    Target("FinPart.count", dict, lambda: _fin_part().count, examples=1),
+    Target("FinPart.max_roll", dict, lambda: _fin_part().max_roll, examples=1),
+    Target("FinPart.max_undulation", dict, lambda: _fin_part().max_undulation, examples=1),
     # --- rod
     Target(
         "view_weights",
@@ -546,7 +594,7 @@ def signature_names(func):
     return tuple(re.findall(r"(\w+): ", first[0].split(") ->")[0])) if first else ()
 
 
-_INSTANCES = {"RodSystem": _chain_system, "AxisBinding": _binding}
+_INSTANCES = {"RodSystem": _chain_system, "AxisBinding": _binding, "FinPart": _fin_part}
 
 
 def generic_target(name):
