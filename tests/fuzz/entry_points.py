@@ -5,6 +5,7 @@ code, not only the first check) and calls the entry point with them. `outputs` n
 arguments the call writes into; `alias` pairs (output, input) the fuzzer may make
 share memory. Objects with state (RodSystem, AxisBinding) are built anew per case."""
 
+import functools
 import os
 import re
 import sys
@@ -215,6 +216,55 @@ def _displace_args():
     }
 
 
+@functools.cache
+def _disc():
+    """tests/python's round fish with a dorsal plate: vertices, edges, fin mask, axis coordinates."""
+    from test_swim_kernels import _disc_fish
+
+    vertices, edges, fin = _disc_fish()
+    coords = np.empty_like(vertices)
+    axis2 = np.array([[0.5, 0, 0], [-0.5, 0, 0]], dtype=np.float64)
+    kn.swim_fin_axis_coordinates(
+        axis2, np.array([0.0, 0.0, 1.0]), vertices, coords, 0, len(vertices)
+    )
+    return vertices, edges, fin, coords
+
+
+def _fin_finder_args():
+    vertices, edges, _, coords = _disc()
+    return {
+        "coordinates": coords.copy(),
+        "edges": edges.copy(),
+        "slices": 48,
+        "sectors": 32,
+        "outside": 1.2,
+        "margin": 0.004,
+        "min_vertices": 8,
+    }
+
+
+def _axis_coordinates_args():
+    vertices = _disc()[0]
+    return {
+        "axis_points": np.array([[0.5, 0, 0], [0.0, 0.05, 0], [-0.5, 0, 0]]),
+        "up": np.array([0.0, 0.0, 1.0]),
+        "vertices": vertices.copy(),
+        "out": np.zeros_like(vertices),
+        "begin": 0,
+        "end": len(vertices),
+    }
+
+
+def _fin_reach_args():
+    vertices, edges, fin, _ = _disc()
+    return {
+        "vertices": vertices.copy(),
+        "edges": edges.copy(),
+        "in_fin": fin.copy(),
+        "seed_radius": 1e-6,
+    }
+
+
 def _fin_args():
     return {
         "rest_points": np.column_stack([np.zeros(5), np.linspace(0, 0.4, 5), np.zeros(5)]),
@@ -347,6 +397,22 @@ TARGETS = [
         },
         kn.swim_speed,
     ),
+    Target("swim_bainbridge_applies", lambda: {"frequency": 6.0}, kn.swim_bainbridge_applies),
+    Target(
+        "swim_fin_axis_coordinates",
+        _axis_coordinates_args,
+        kn.swim_fin_axis_coordinates,
+        outputs=("out",),
+        alias=(("out", "vertices"),),
+        examples=60,
+    ),
+    Target("swim_find_fins", _fin_finder_args, kn.swim_find_fins, examples=60),
+    Target(
+        "swim_nearest_distances",
+        lambda: {"points": _disc()[0][:50].copy(), "cloud": _disc()[0].copy()},
+        kn.swim_nearest_distances,
+    ),
+    Target("swim_fin_reach", _fin_reach_args, kn.swim_fin_reach, examples=60),
     Target("FinPart", _fin_part_args, kn.FinPart, examples=80),
     Target(
         "FinPart.displace",
