@@ -420,6 +420,8 @@ STRINGS = {
     # Strings added by the gait branch
     "Find the four legs (by name, or from four selected feet) and the bone that carries the animal; fill in a horse's gaits scaled to this animal and joint ranges from its rest pose": "4本の脚（名前から、または選択した4つの足から）と動物を運ぶボーンを見つけ、この動物に合わせた馬の歩容とレストポーズからの関節可動域を設定します",
     "Joint Ranges": "関節可動域",
+    "How far each leg joint may bend": "脚の各関節がどこまで曲がれるか",
+    "Where each joint's bending range comes from": "各関節の曲げ範囲の決め方",
     "From Rest Pose": "レストポーズから",
     "Each joint bends the way it bends at rest, within a range around it": "各関節はレストでの曲がり方を中心にその範囲内で曲がります",
     "Horse": "馬",
