@@ -1,16 +1,20 @@
-"""Fish swim demo: six procedural fish, one per swimming mode, built and set up
+"""Fish swim demo: seven procedural fish, one per swimming preset, built and set up
 with the add-on's own operators (the dolphin then baked to out/dolphin_swim.pc2
 and a Mesh Cache modifier); saves out/fish.blend and renders
-out/fish_sheet.png, a contact sheet with one row per fish — tuna (thunniform),
-eel (anguilliform), boxfish (ostraciiform), filefish (balistiform), pufferfish
-(labriform), dolphin (cetacean) — and eight columns: four frames a quarter tail
-beat apart seen from above (tilted 30 degrees toward the viewer), then the same
-four frames seen from the side.
+out/fish_sheet.png, a contact sheet with one row per fish, each labelled with
+its preset — tuna (thunniform), tuna (carangiform), eel (anguilliform), boxfish
+(ostraciiform), filefish (balistiform), pufferfish (labriform), dolphin
+(cetacean) — and eight columns: four frames a quarter tail beat apart seen from
+above (tilted 30 degrees toward the viewer), then the same four frames seen from
+the side; and out/fish_<preset>.gif, one looping tail beat of each seen from
+above (12 frames, made from the rendered frames with Debian's ffmpeg).
 Runs in Blender 3.4 via tools/run_demo.sh.
 """
 
 import math
 import os
+import shutil
+import subprocess
 import sys
 
 import bpy
@@ -24,10 +28,13 @@ OUT = os.environ.get(
 )
 TILE = (240, 136)
 FRAMES = (1, 4, 7, 10)  # a quarter beat apart at 2 Hz, 24 fps
+BEAT = range(1, 13)  # one whole beat at 2 Hz, 24 fps: the animated pictures loop
+FONT = "/usr/share/fonts/truetype/dejavu/DejaVuSans-Bold.ttf"
 
 FISH = (
     # kind, preset, colour body, colour fins, frequency
     ("tuna", "THUNNIFORM", (0.08, 0.12, 0.3), (0.75, 0.6, 0.15), 2.0),
+    ("tuna", "CARANGIFORM", (0.25, 0.3, 0.32), (0.55, 0.5, 0.3), 2.0),
     ("eel", "ANGUILLIFORM", (0.18, 0.16, 0.08), (0.35, 0.3, 0.15), 2.0),
     ("boxfish", "OSTRACIIFORM", (0.8, 0.65, 0.1), (0.9, 0.85, 0.5), 2.0),
     ("filefish", "BALISTIFORM", (0.35, 0.45, 0.2), (0.6, 0.7, 0.4), 2.0),
@@ -133,6 +140,57 @@ def render_tile(scene, camera, frame, path):
     return pixels
 
 
+def _ffmpeg(*args):
+    """Run Debian's ffmpeg quietly; False (and a note) when it is missing or fails."""
+    if shutil.which("ffmpeg") is None:
+        print("ffmpeg not found: skipping the labels and animated pictures")
+        return False
+    result = subprocess.run(["ffmpeg", "-y", "-loglevel", "error", *args], check=False)
+    return result.returncode == 0
+
+
+def label_sheet(path, labels, row_height):
+    """Write each row's preset name into its top-left corner (ffmpeg drawtext)."""
+    font = FONT if os.path.exists(FONT) else None
+    filters = [
+        "drawtext="
+        + (f"fontfile={font}:" if font else "")
+        + f"text='{text}':x=8:y={row * row_height + 6}:fontsize=15:fontcolor=white"
+        ":box=1:boxcolor=black@0.55:boxborderw=4"
+        for row, text in enumerate(labels)
+    ]
+    labelled = path.replace(".png", "_labelled.png")
+    if _ffmpeg("-i", path, "-vf", ",".join(filters), labelled):
+        os.replace(labelled, path)
+
+
+def write_gif(frames, path, label):
+    """An endlessly looping GIF of the rendered frames (12 fps), with its label."""
+    folder = os.path.dirname(frames[0])
+    pattern = os.path.join(folder, "_beat_%02d.png")
+    for i, frame in enumerate(frames):
+        os.replace(frame, pattern % i)
+    font = FONT if os.path.exists(FONT) else None
+    text = (
+        "drawtext="
+        + (f"fontfile={font}:" if font else "")
+        + f"text='{label}':x=6:y=6:fontsize=13:fontcolor=white:box=1:boxcolor=black@0.55"
+        ":boxborderw=3"
+    )
+    graph = f"{text},split[a][b];[a]palettegen=stats_mode=diff[p];[b][p]paletteuse=dither=bayer"
+    _ffmpeg("-framerate", "12", "-i", pattern, "-filter_complex", graph, "-loop", "0", path)
+    for i in range(len(frames)):
+        os.remove(pattern % i)
+
+
+def render_still(scene, camera, frame, path):
+    scene.camera = camera
+    scene.frame_set(frame)
+    scene.render.filepath = path
+    bpy.ops.render.render(write_still=True)
+    return path
+
+
 def main():
     os.makedirs(OUT, exist_ok=True)
     scene, fish = build_scene()
@@ -143,19 +201,37 @@ def main():
     sheet = np.ones(
         ((height + gap) * len(fish), (width + gap) * columns + gap * 3, 4), dtype=np.float32
     )
+    labels = []
     for row, obj in enumerate(fish):
         for other in fish:
             other.hide_render = other is not obj
         aim(top, side, obj)
+        preset = obj.kodawari_swim.preset
+        label = f"{presets_label(preset)} ({FISH[row][0]})"
+        labels.append(label)
+        # From above: one whole beat, rendered once, feeds both the sheet and the GIF.
+        beat = [
+            render_still(scene, top, frame, os.path.join(OUT, f"_top_{row}_{frame:02d}.png"))
+            for frame in BEAT
+        ]
         for view, camera in enumerate((top, side)):
             for c, frame in enumerate(FRAMES):
-                tile = render_tile(
-                    scene, camera, frame, os.path.join(OUT, f"_tile_{row}_{view}_{c}.png")
-                )
+                if view == 0:
+                    path = beat[frame - BEAT[0]]
+                    image = bpy.data.images.load(path)
+                    tile = np.array(image.pixels[:], dtype=np.float32).reshape(
+                        image.size[1], image.size[0], 4
+                    )
+                    bpy.data.images.remove(image)
+                else:
+                    tile = render_tile(
+                        scene, camera, frame, os.path.join(OUT, f"_tile_{row}_{view}_{c}.png")
+                    )
                 # Image rows run bottom-up: the first fish goes to the top of the sheet.
                 y0 = sheet.shape[0] - (row + 1) * (height + gap)
                 x0 = (view * len(FRAMES) + c) * (width + gap) + view * gap * 3
                 sheet[y0 : y0 + height, x0 : x0 + width] = tile
+        write_gif(beat, os.path.join(OUT, f"fish_{preset.lower()}.gif"), label)
     for obj in fish:
         obj.hide_render = False
     # The dolphin is baked to a PC2 point cache played by Blender's Mesh Cache modifier,
@@ -177,7 +253,14 @@ def main():
     image.filepath_raw = os.path.join(OUT, "fish_sheet.png")
     image.file_format = "PNG"
     image.save()
-    print(f"wrote {os.path.join(OUT, 'fish.blend')} and {image.filepath_raw}")
+    label_sheet(image.filepath_raw, labels, height + gap)
+    print(f"wrote {os.path.join(OUT, 'fish.blend')}, {image.filepath_raw} and out/fish_*.gif")
+
+
+def presets_label(preset):
+    from kodawari.fish import presets
+
+    return presets.LABELS[preset][0]
 
 
 main()

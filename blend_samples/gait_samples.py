@@ -200,13 +200,15 @@ def skin_armature(rig, scene, bone_names, radius):
         c = vertex(b.tail_local, b.name, r_at(b.tail_local.z))
         if a != c:
             edges.append((a, c))
-        if b.parent is not None and b.parent.name in bone_names and not b.use_connect:
-            # join an unconnected child to the nearest end of its parent
-            p = b.parent
+        p = b.parent
+        while p is not None and p.name not in bone_names:
+            p = p.parent  # skip bones left out of the body (Rigify's pelvis.L)
+        if p is not None and (p is not b.parent or not b.use_connect):
+            # join an unconnected child to the nearest end of its (kept) parent
             near = min((p.head_local, p.tail_local), key=lambda q: (q - b.head_local).length)
             edges.append((vertex(near, p.name, r_at(near.z)), a))
     mesh = bpy.data.meshes.new(rig.name + "Skin")
-    mesh.from_pydata(verts, sorted(set(tuple(sorted(e)) for e in edges if e[0] != e[1])), [])
+    mesh.from_pydata(verts, sorted({tuple(sorted(e)) for e in edges if e[0] != e[1]}), [])
     body = bpy.data.objects.new(rig.name + "Body", mesh)
     scene.collection.objects.link(body)
     body.parent = rig

@@ -48,7 +48,7 @@ def hair():
 
 
 def gait():
-    from kodawari.gait import samples
+    import gait_samples as samples
 
     rig, _ = samples.build_horse(bpy.context.scene)
     _activate(rig)

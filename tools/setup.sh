@@ -21,7 +21,7 @@ die() { printf '[setup] ERROR: %s\n' "$*" >&2; exit 1; }
 # --- Debian packages ---------------------------------------------------------
 DEBS=(blender libeigen3-dev libglm-dev libgtest-dev libgmock-dev libbenchmark-dev
       python3-pytest python3-numpy g++ make
-      ffmpeg  # the hair demo's swing GIF (blend_samples/hair_demo.py)
+      ffmpeg fonts-dejavu-core  # the demos' GIFs (fish, hair, gait) and the fish sheet's labels
       xvfb xauth libgl1-mesa-dri)  # a virtual screen for the tests that need Blender's window
 missing=()
 for pkg in "${DEBS[@]}"; do

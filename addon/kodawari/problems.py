@@ -63,8 +63,9 @@ def report(obj, feature, exc):
     print(line)
     if not bpy.app.background:  # headless, the console is where the user looks
         _pending.append(line)
-        if len(_pending) == 1:
-            bpy.app.timers.register(_show_pending, first_interval=0.1)
+        if not bpy.app.timers.is_registered(_show_pending):
+            # Persistent: a file opened meanwhile must not strand the waiting messages.
+            bpy.app.timers.register(_show_pending, first_interval=0.1, persistent=True)
     return message
 
 

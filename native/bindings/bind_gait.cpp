@@ -108,6 +108,7 @@ void bind_gait(py::module_& m) {
 
   m.def("gait_horse_table", [](double leg_length) {
         const GaitTable t = horse_gait_table();
+        require_finite(leg_length, "leg_length");
         return table_to(leg_length > 0 ? scale_table(t, leg_length) : t);
       }, py::arg("leg_length") = 0.0,
       "The horse defaults: {'gaits': (5, 12) float64 in GAIT_COLUMNS order, 'use_froude', 'hysteresis', 'reach'};"
@@ -115,7 +116,8 @@ void bind_gait(py::module_& m) {
 
   m.def("gait_duty_factor", [](const py::dict& table, int gait, double speed, double leg_length) {
         if (gait < 0 || gait >= kGaitCount) throw py::value_error("gait must be 0..4");
-        return duty_at(table_from(table), static_cast<Gait>(gait), speed, leg_length);
+        return duty_at(table_from(table), static_cast<Gait>(gait), require_finite(speed, "speed"),
+                       require_finite(leg_length, "leg_length"));
       }, py::arg("table"), py::arg("gait"), py::arg("speed"), py::arg("leg_length"),
       "The duty factor a gait uses at a speed (falls with speed where duty_factor_top says so).");
 
@@ -127,7 +129,8 @@ void bind_gait(py::module_& m) {
         auto m = checked_array<double>(mode, "gait_mode", frames, 0);
         std::vector<int> modes(frames);
         for (py::ssize_t f = 0; f < frames; ++f) modes[f] = static_cast<int>(m.data()[f]);
-        const SpeedProblem p = check_speeds(t, s.data(), modes.data(), static_cast<int>(frames), leg_length);
+        const SpeedProblem p = check_speeds(t, s.data(), modes.data(), static_cast<int>(frames),
+                                            require_finite(leg_length, "leg_length"));
         return py::make_tuple(p.frame, p.top);
       }, py::arg("table"), py::arg("speed"), py::arg("gait_mode"), py::arg("leg_length"),
       "(frame index, top speed) of the first frame faster than its gait mode allows, or (-1, 0).");
@@ -226,20 +229,20 @@ void bind_gait(py::module_& m) {
         if (!(fps > 0 && fps <= 1000)) throw py::value_error("fps must be in (0, 1000]");
         if (!(acceleration > 0)) throw py::value_error("acceleration must be > 0");
         require_finite(acceleration, "acceleration");
-        // The table's speed range (as gait_table_speed_max gives it): past it no gait fits
-        // and the legs cannot follow the body (a 10 km/s bake missed its feet by 55 m).
-        double leg_length = 0;
-        for (int leg : {kLH, kRH}) leg_length = std::max(leg_length, in.rig.legs[leg].heads[0].z() - in.rig.legs[leg].tail.z());
-        for (py::ssize_t f = 0; f < frames; ++f) {
-          const double top = table_speed_max(in.table, static_cast<int>(mode.data()[f]), leg_length);
-          if (speed.data()[f] > top + 1e-6) {
-            throw py::value_error("target_speed[" + std::to_string(f) + "] = " + std::to_string(speed.data()[f]) +
-                                  " is past the top speed " + std::to_string(top) + " of the gait table");
-          }
-        }
         if (ccd_iterations < 1 || ccd_iterations > 1000) throw py::value_error("ccd_iterations must be 1..1000");
         in.target_speed.assign(speed.data(), speed.data() + frames);
         for (py::ssize_t f = 0; f < frames; ++f) in.gait_mode.push_back(static_cast<int>(mode.data()[f]));
+        // The table's speed range (the add-on's rule, check_speeds): past it no gait fits and
+        // the legs cannot follow the body (a 10 km/s bake missed its feet by 55 m).
+        double leg_length = 0;  // hip height above the feet, as the add-on measures it
+        for (int leg : {kLH, kRH}) leg_length = std::max(leg_length, in.rig.legs[leg].heads[0].z() - in.rig.legs[leg].tail.z());
+        const SpeedProblem too_fast = check_speeds(in.table, in.target_speed.data(), in.gait_mode.data(),
+                                                   static_cast<int>(frames), leg_length);
+        if (too_fast.frame >= 0) {
+          throw py::value_error("target_speed[" + std::to_string(too_fast.frame) + "] = " +
+                                std::to_string(in.target_speed[too_fast.frame]) + " is past the top speed " +
+                                std::to_string(too_fast.top) + " of the gait table");
+        }
         in.fps = fps;
         in.acceleration = acceleration;
         in.ccd_iterations = ccd_iterations;

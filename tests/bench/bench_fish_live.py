@@ -22,9 +22,9 @@ sys.path.insert(
     ),
 )
 import benchlib
+import fish_shapes
 
 print = benchlib.say  # each line at once, also through a pipe
-import fish_shapes  # noqa: E402
 
 FRAMES = 8
 STARTS = {"frame_10": 10, "frame_10000": 10_000}

@@ -9,6 +9,7 @@ import numpy as np
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 sys.path.insert(0, os.path.join(ROOT, "blend_samples"))
 import fish_shapes
+import smooth_fish  # noqa: F401  (re-exported for the tests)
 
 FIN_KIND = {
     "fin_dorsal": "DORSAL",

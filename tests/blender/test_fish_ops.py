@@ -63,10 +63,8 @@ def test_bake_equals_live(empty_scene, tmp_path, target):
         frame_start=1, frame_end=12, target=target, filepath=cache
     ) == {"FINISHED"}
     assert (
-        obj.kodawari_swim.baked == target
-        and not obj.kodawari_swim.enabled
-        or obj.kodawari_swim.baked == target
-    )
+        obj.kodawari_swim.baked == target and not obj.kodawari_swim.enabled
+    ) or obj.kodawari_swim.baked == target
     if target == "MESH_CACHE":
         assert os.path.isfile(cache)
         assert obj.modifiers[0].type == "MESH_CACHE"

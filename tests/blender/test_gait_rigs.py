@@ -6,9 +6,15 @@ is measured on the evaluated pose (scene.frame_set), in world metres."""
 import bpy
 import numpy as np
 import pytest
-
-from gait_scene import build, evaluated_legs, expected_feet, headings, joint_angles, planted_snaps, \
-    select_pose_bones
+from gait_scene import (
+    build,
+    evaluated_legs,
+    expected_feet,
+    headings,
+    joint_angles,
+    planted_snaps,
+    select_pose_bones,
+)
 
 CASES = ["wolf", "horse", "cat@0.01", "mixamo@0.01", "unreal+connected", "max_biped@0.01+connected", "game"]
 LEGS = ("LF", "RF", "LH", "RH")

@@ -122,3 +122,25 @@ def test_zero_length_bone_in_the_leg_plane_changes_nothing(empty_scene):
     with pytest.raises(RuntimeError, match="zero length"):
         bpy.ops.kodawari.gait_setup()
     assert len(rig.kodawari_gait.legs) == 0
+
+
+@pytest.mark.parametrize("case,femur", [("sample_horse", 1), ("wolf", 0)])
+def test_fore_and_hind_legs_get_their_own_stiffness_with_the_hind_femur_leading(empty_scene, case, femur):
+    """Takizawa: plain CCD moves the bones nearest the foot first; the hind femur should
+    lead. The hind femur (below a sloping pelvis on the sample horse, the thigh of the
+    Rigify wolf) takes the largest share; the fore leg keeps (0.1, 0.3, 0.5, 1.0)."""
+    from gait_scene import rigify_metarig
+
+    if case == "sample_horse":
+        rig = horse(empty_scene)
+    else:
+        rig = rigify_metarig(empty_scene, "wolf")
+        bpy.context.view_layer.objects.active = rig
+        assert bpy.ops.kodawari.gait_setup() == {"FINISHED"}
+    legs = rig.kodawari_gait.legs
+    for side in "LR":
+        hind = [b.stiffness for b in legs[side + "H"].bones]
+        fore = [b.stiffness for b in legs[side + "F"].bones]
+        assert hind[femur] == max(hind) == pytest.approx(1.0), hind
+        assert hind != fore
+        assert fore[0] == pytest.approx(0.1) and fore[1] > fore[0]

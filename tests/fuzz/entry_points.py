@@ -6,6 +6,7 @@ arguments the call writes into; `alias` pairs (output, input) the fuzzer may mak
 share memory. Objects with state (RodSystem, AxisBinding) are built anew per case."""
 
 import os
+import re
 import sys
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -14,7 +15,7 @@ import kodawari_native as kn
 import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-sys.path.insert(0, os.path.join(os.path.dirname(HERE), "python"))
+sys.path.append(os.path.join(os.path.dirname(HERE), "python"))
 from gait_rigs import horse_rig
 
 
@@ -26,12 +27,12 @@ class Target:
     outputs: tuple = ()
     alias: tuple = ()  # (output, input) pairs of the same dtype
     examples: int = 60
-    extra_names: tuple = field(
-        default_factory=tuple
-    )  # words an error may name besides the arguments
+    # words an error may name besides the arguments
+    extra_names: tuple = field(default_factory=tuple)
+    generic: bool = False  # no valid call known: called with random positional arguments
 
     def __post_init__(self):  # a gait table's rows and columns name what is wrong in table['gaits']
-        if "table" in self.make_args():
+        if not self.generic and "table" in self.make_args():
             self.extra_names = (
                 tuple(self.extra_names) + tuple(kn.GAIT_COLUMNS) + tuple(kn.GAIT_NAMES)
             )
@@ -443,7 +444,22 @@ TARGETS = [
         examples=1,
     ),
     # --- gait
-    Target("gait_horse_table", dict, kn.gait_horse_table, examples=1),
+    Target("gait_horse_table", lambda: {"leg_length": 1.4}, kn.gait_horse_table, examples=30),
+    Target(
+        "gait_duty_factor",
+        lambda: {"table": kn.gait_horse_table(), "gait": 3, "speed": 9.0, "leg_length": 1.4},
+        kn.gait_duty_factor,
+    ),
+    Target(
+        "gait_check_speeds",
+        lambda: {
+            "table": kn.gait_horse_table(),
+            "speed": np.linspace(0.0, 12.0, 8),
+            "gait_mode": np.array([-1.0, -1, 0, 1, 2, 3, 4, -1]),
+            "leg_length": 1.4,
+        },
+        kn.gait_check_speeds,
+    ),
     Target("gait_validate_table", lambda: {"table": kn.gait_horse_table()}, kn.gait_validate_table),
     Target("gait_validate_rig", lambda: {"rig": horse_rig()}, kn.gait_validate_rig, examples=80),
     Target(
@@ -522,3 +538,40 @@ def public_entry_points():
         elif callable(obj):
             names.append(name)
     return names
+
+
+def signature_names(func):
+    """Argument names from pybind11's signature line: "f(a: int, b: object) -> None"."""
+    first = (getattr(func, "__doc__", None) or "").splitlines()
+    return tuple(re.findall(r"(\w+): ", first[0].split(") ->")[0])) if first else ()
+
+
+_INSTANCES = {"RodSystem": _chain_system, "AxisBinding": _binding}
+
+
+def generic_target(name):
+    """A Target for an entry point nobody wrote a valid call for yet (e.g. one added
+    after this file): random positional arguments, same oracle. None when it cannot
+    be reached (a member of a class this file does not know how to build)."""
+    if "." in name:
+        cls, member = name.split(".", 1)
+        if cls not in _INSTANCES:
+            return None
+        make_self = _INSTANCES[cls]
+        attr = getattr(getattr(kn, cls), member)
+        names = signature_names(attr) if callable(attr) else ()
+
+        def call(*args):
+            value = getattr(make_self(), member)
+            return value(*args) if callable(value) else value
+    else:
+        call = getattr(kn, name)
+        names = signature_names(call.__init__ if isinstance(call, type) else call)
+    return Target(name, dict, call, examples=60, extra_names=names, generic=True)
+
+
+def all_targets():
+    """TARGETS, plus a generic target for every public entry point they miss."""
+    covered = {t.name for t in TARGETS}
+    extra = [generic_target(n) for n in public_entry_points() if n not in covered]
+    return TARGETS + [t for t in extra if t is not None]

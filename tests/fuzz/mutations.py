@@ -333,3 +333,42 @@ def describe(kwargs):
             text = repr(v)
             parts.append(f"{k}={text if len(text) < 80 else text[:77] + '...'}")
     return ", ".join(parts)
+
+
+@st.composite
+def junk_array(draw):
+    shape = tuple(draw(st.lists(st.integers(0, 6), min_size=0, max_size=3)))
+    dtype = draw(st.sampled_from([np.float64, np.float32, np.int32, np.int64, np.bool_]))
+    size = int(np.prod(shape)) if shape else 1
+    values = [
+        special_float(draw) if draw(st.booleans()) else draw(st.floats(-10, 10))
+        for _ in range(size)
+    ]
+    with np.errstate(all="ignore"):
+        arr = np.array(values, dtype=np.float64).reshape(shape)
+        if dtype != np.float64:
+            arr = np.nan_to_num(arr, nan=0, posinf=1, neginf=-1).clip(-1e6, 1e6).astype(dtype)
+    return arr
+
+
+def junk_value():
+    leaf = st.one_of(
+        junk_array(),
+        st.builds(lambda: None),
+        st.sampled_from(["", "FLAP", "NONE", "text"]),
+        st.integers(-(2**40), 2**40),
+        st.sampled_from(SPECIAL),
+        st.booleans(),
+    )
+    return st.one_of(
+        leaf,
+        st.dictionaries(
+            st.sampled_from(["heights", "nx", "x0", "legs", "gaits"]), leaf, max_size=3
+        ),
+        st.lists(leaf, max_size=3),
+    )
+
+
+def junk_arguments():
+    """0 to 6 positional arguments of any kind, for an entry point with no known valid call."""
+    return st.lists(junk_value(), max_size=6)

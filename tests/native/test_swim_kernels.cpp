@@ -62,7 +62,9 @@ TEST(BodyWave, TailTipPeakMatchesAmplitudeWithLengthKept) {
     }
     EXPECT_GE(polygon_length(axis), 2.0 - 1e-9);
   }
-  EXPECT_NEAR(peak, 0.1 * 2.0, 0.01 * 0.2);
+  // The control offsets are a least-squares fit of the curve to the wave (so its
+  // wavelength is right), which leaves the tail tip within 2% of the set amplitude.
+  EXPECT_NEAR(peak, 0.1 * 2.0, 0.02 * 0.2);
 }
 
 TEST(BodyWave, WaveTravelsTailward) {

@@ -101,3 +101,175 @@ def test_body_axis_rejects_bad_input_naming_it(kwargs, name):
     args.update(kwargs)
     with pytest.raises(ValueError, match=name):
         kn.swim_body_axis(**args)
+
+
+def test_speed_modes_stay_physical():
+    # Bainbridge below ~5 Hz leaves the Strouhal band: the Strouhal speed (St 0.3) instead.
+    length, frequency, amplitude = 1.0, 1.2, 0.05
+    peak_to_peak = 2 * amplitude * length
+    speed = kn.swim_speed("BAINBRIDGE", length, frequency, amplitude, 0.3)
+    assert frequency * peak_to_peak / speed == pytest.approx(0.3)
+    assert not kn.swim_bainbridge_applies(1.2) and kn.swim_bainbridge_applies(6.0)
+    # No body wave: fin swimmers cruise at half a body length per beat in every mode.
+    for mode in ("BAINBRIDGE", "STROUHAL"):
+        assert kn.swim_speed(mode, 0.4, 2.0, 0.0, 0.3) == pytest.approx(0.5 * 0.4 * 2.0)
+
+
+def _disc_fish(n_rings=40, n_around=32, fin=True):
+    """A round body along -x with a thin dorsal plate; returns vertices, edges, fin mask."""
+    s = np.linspace(0.0, 1.0, n_rings)
+    radius = 0.02 + 0.1 * np.sin(np.pi * np.clip(s, 0.02, 0.98))
+    angles = np.linspace(0, 2 * np.pi, n_around, endpoint=False)
+    ring = np.stack(
+        [
+            np.repeat(0.5 - s, n_around),
+            (radius[:, None] * np.cos(angles)).reshape(-1),
+            (radius[:, None] * np.sin(angles)).reshape(-1),
+        ],
+        axis=1,
+    )
+    edges = []
+    for r in range(n_rings):
+        for k in range(n_around):
+            a = r * n_around + k
+            edges.append((a, r * n_around + (k + 1) % n_around))
+            if r + 1 < n_rings:
+                edges.append((a, a + n_around))
+    vertices = [ring]
+    mask = np.zeros(len(ring), dtype=bool)
+    if fin:
+        top = n_around // 4
+        base = [r * n_around + top for r in range(15, 25)]
+        start = len(ring)
+        rows = []
+        for j in range(1, 6):
+            rows.append(ring[base] + [0.0, 0.0, 0.012 * j])
+        plate = np.concatenate(rows)
+        vertices.append(plate)
+        mask = np.concatenate([mask, np.ones(len(plate), dtype=bool)])
+        for j in range(5):
+            for c in range(len(base)):
+                here = start + j * len(base) + c
+                below = base[c] if j == 0 else here - len(base)
+                edges.append((below, here))
+                if c:
+                    edges.append((here - 1, here))
+    return (
+        np.ascontiguousarray(np.concatenate(vertices), dtype=np.float32),
+        np.ascontiguousarray(edges, dtype=np.int32),
+        mask,
+    )
+
+
+def test_fin_finder_finds_a_dorsal_plate_and_nothing_of_a_plain_body():
+    vertices, edges, truth = _disc_fish()
+    axis = np.ascontiguousarray([[0.5, 0, 0], [-0.5, 0, 0]], dtype=np.float64)
+    coords = np.empty_like(vertices)
+    kn.swim_fin_axis_coordinates(
+        axis, np.array([0.0, 0.0, 1.0]), vertices, coords, 0, len(vertices)
+    )
+    kinds = kn.swim_find_fins(coords, edges)
+    found = kinds == 2  # dorsal
+    assert found[truth].mean() > 0.6 and not found[~truth].any()
+    assert not (kinds[~truth] > 0).any()
+    plain, plain_edges, _ = _disc_fish(fin=False)
+    kn.swim_fin_axis_coordinates(
+        axis, np.array([0.0, 0.0, 1.0]), plain, coords[: len(plain)], 0, len(plain)
+    )
+    assert not kn.swim_find_fins(np.ascontiguousarray(coords[: len(plain)]), plain_edges).any()
+    with pytest.raises(ValueError, match="out of range"):
+        kn.swim_find_fins(coords, np.array([[0, len(vertices)]], dtype=np.int32))
+
+
+def test_nearest_distances_and_fin_reach():
+    rng = np.random.default_rng(3)
+    cloud = rng.random((3000, 3)).astype(np.float32)
+    points = (rng.random((200, 3)) * 1.4 - 0.2).astype(np.float32)
+    brute = np.sqrt(((points[:, None, :] - cloud[None]) ** 2).sum(axis=2)).min(axis=1)
+    assert np.allclose(kn.swim_nearest_distances(points, cloud), brute, atol=1e-6)
+    vertices, edges, fin = _disc_fish()
+    reach, source = kn.swim_fin_reach(vertices, edges, fin, 1e-6)
+    assert (reach[~fin] == 0).all() and (source[~fin] == np.flatnonzero(~fin)).all()
+    # The plate's rows stand 0.012 apart: reach grows row by row from the body.
+    rows = reach[fin].reshape(5, -1)
+    assert np.allclose(rows[:, 0], 0.012 * np.arange(1, 6), atol=1e-6)
+
+
+def test_fin_part_swings_each_vertex_about_its_own_root():
+    heights = np.repeat(np.linspace(0.0, 0.1, 6), 5)
+    along = np.tile(np.linspace(0.0, 0.2, 5), 6)
+    points = np.stack([along, np.zeros_like(along), heights], axis=1).astype(np.float32)
+    part = kn.FinPart(
+        points,
+        heights.astype(np.float64),
+        np.ones_like(heights),
+        np.array([0.1, 0.0, 0.0]),
+        np.array([0.0, 0.0, 1.0]),
+        np.array([1.0, 0.0, 0.0]),
+        np.array([0.0, 1.0, 0.0]),
+        np.array([0.0, 0.0, 1.0]),
+        0.1,
+        0.2,
+        0.0,
+    )
+    probes = np.ascontiguousarray([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]], dtype=np.float32)
+    out = np.empty_like(points)
+    part.displace("FLAP", 0.5, math.pi / 2, 0.0, 1.0, False, probes, probes, out)
+    moved = points + out
+    # Every row keeps its length along the body and every column its height above its root.
+    rows = moved.reshape(6, 5, 3)
+    assert np.allclose(np.linalg.norm(np.diff(rows, axis=1), axis=2), 0.05, atol=1e-6)
+    assert np.allclose(
+        np.linalg.norm(rows[:, :, :] - rows[:1, :, :], axis=2)[:, 0], heights[::5], atol=1e-6
+    )
+    assert np.abs(out[:5]).max() == 0.0  # the root row stays on the body
+
+
+# Each preset's body wave (wavelength, tail and snout amplitude, envelope start and power).
+PRESET_WAVES = {
+    "ANGUILLIFORM": (0.6, 0.05, 0.025, 0.0, 1.0),
+    "CARANGIFORM": (1.0, 0.06, 0.006, 0.45, 1.6),
+    "THUNNIFORM": (1.25, 0.055, 0.003, 0.6, 2.2),
+    "CETACEAN": (1.25, 0.06, 0.006, 0.5, 2.0),
+}
+
+
+@pytest.mark.parametrize(
+    "preset,points",
+    [("ANGUILLIFORM", n) for n in (16, 24)]
+    + [(p, n) for p in ("CARANGIFORM", "THUNNIFORM", "CETACEAN") for n in (8, 12, 16, 24)],
+)
+def test_body_curve_wavelength_within_five_percent_of_the_setting(preset, points):
+    """The wavelength the mesh follows: the phase slope of the fundamental, along the
+    body, of points fixed on the B-spline curve (where the FFD binds vertices), fitted
+    where the wave is at least a third of its largest amplitude."""
+    wavelength, amplitude, head, start, power = PRESET_WAVES[preset]
+    rest = np.ascontiguousarray(
+        np.stack([np.linspace(0.5, -0.5, points), np.zeros(points), np.zeros(points)], axis=1)
+    )
+    t = np.linspace(0.0, 1.0, 200)
+    s = 0.5 - kn.curve_points(rest, t)[:, 0]
+    offsets = np.array(
+        [
+            kn.curve_points(
+                kn.swim_body_axis(
+                    rest,
+                    LATERAL,
+                    1.0,
+                    2 * math.pi * k / 24,
+                    wavelength=wavelength,
+                    amplitude=amplitude,
+                    amplitude_head=head,
+                    envelope_start=start,
+                    envelope_power=power,
+                ),
+                t,
+            )[:, 1]
+            for k in range(24)
+        ]
+    )
+    spectrum = np.fft.rfft(offsets, axis=0)[1]
+    used = np.abs(spectrum) > np.abs(spectrum).max() / 3
+    slope = np.polyfit(s[used], np.unwrap(np.angle(spectrum))[used], 1)[0]
+    measured = 2 * math.pi / abs(slope)
+    assert abs(measured / wavelength - 1) <= 0.05, (measured, wavelength)

@@ -255,6 +255,9 @@ def broken_fish_is_reported_once_in_the_report_area():
     shown = len(problems.shown)
     for frame in range(2, 12):
         scene.frame_set(frame)
+    yield from wait_until(lambda: len(problems.shown) > shown, "the report")
+    for frame in range(12, 16):
+        scene.frame_set(frame)
     yield 0.5
     said = [line for line in problems.shown[shown:] if "tuna" in line]
     assert len(said) == 1 and "fin_dorsal" in said[0], problems.shown[shown:]

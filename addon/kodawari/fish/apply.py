@@ -32,8 +32,12 @@ class KODAWARI_OT_swim_apply(bpy.types.Operator):
             ops.remove_swim(obj)
         bulk.set_vertex_positions(obj.data, positions)
         obj.data.update()
-        self.report({"INFO"}, tip_("Fish Swim applied to '{}': the shape at frame {} is now its mesh").format(
-            obj.name, context.scene.frame_current))
+        self.report(
+            {"INFO"},
+            tip_("Fish Swim applied to '{}': the shape at frame {} is now its mesh").format(
+                obj.name, context.scene.frame_current
+            ),
+        )
         return {"FINISHED"}
 
 
@@ -42,14 +46,20 @@ def _refusal(obj):
         return tip_("Select the swimming mesh object first")
     settings = obj.kodawari_swim
     if settings.baked != "NONE":
-        return tip_("'{}' is baked: remove or free the bake before applying the swim").format(obj.name)
+        return tip_("'{}' is baked: remove or free the bake before applying the swim").format(
+            obj.name
+        )
     if runtime.swim_key_block(obj) is None:
         return tip_("'{}' has no Fish Swim to apply").format(obj.name)
     keys = obj.data.shape_keys
-    others = [b.name for b in keys.key_blocks if b.name != runtime.SHAPE_KEY and b != keys.reference_key]
+    others = [
+        b.name for b in keys.key_blocks if b.name != runtime.SHAPE_KEY and b != keys.reference_key
+    ]
     if others:
-        return tip_("Cannot apply to a mesh with other shape keys ({}): apply or remove them first, "
-                    "as for any modifier").format(", ".join(others))
+        return tip_(
+            "Cannot apply to a mesh with other shape keys ({}): apply or remove them first, "
+            "as for any modifier"
+        ).format(", ".join(others))
     return None
 
 

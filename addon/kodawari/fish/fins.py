@@ -1,39 +1,43 @@
-"""Fin set-up (docs/algorithms.md §2.4): a small control axis per fin, bound once.
+"""Fin set-up (docs/algorithms.md §2.4-§2.5): each fin part bound once in the core.
 
-A fin's vertices come from a vertex group. Its axis runs root → tip with the
-first three of five control points clustered at the root (they stay fixed, so
-the fin never tears from the body); an undulating fin's axis runs along its base
-instead. Each fin vertex blends from the body's motion at the root to the fin's
-own motion further out, so root vertices move exactly with the body.
+A fin's vertices come from a vertex group. How far each stands from the body is
+its path across the fin from where it meets the body (fin_reach, native); the
+fin's motion swings every vertex about its own root point by that reach, faded
+in from 0 at the root (so root vertices move exactly with the body and the fin
+never tears from it) to the full motion over the first root_blend of the fin
+(an undulating fin: over its whole height). The core (kodawari_native.FinPart)
+turns the motion with the body's rotation at the fin root every frame.
 """
 
 import numpy as np
-from mathutils import kdtree
-
-# Seed: of 5 points, the first 3 close together near the root (fixed).
-ROOT_CLUSTER = (0.0, 0.05, 0.1, 0.55, 1.0)
-UNDULATE_POINTS = 7
 
 
 class FinPart:
-    """One side of one fin, bound to its own axis (a group holding a left and a
-    right pectoral fin becomes two parts that beat as mirror images)."""
+    """One side of one fin, bound for motion in the core (kodawari_native.FinPart): each
+    vertex swings about its own root point, faded in from the body (a group holding a
+    left and a right pectoral fin becomes two parts that beat as mirror images)."""
 
-    def __init__(self, fin_index, indices, weights, rest, axis, frame, root, amplitude_scale, kn):
+    def __init__(self, fin_index, indices, weights, rest, reach, root, tip, frame, base, kn):
         self.fin_index = fin_index
         self.indices = indices  # int64 (M,) vertex indices into the mesh
-        self.weights = weights  # float32 (M, 1) group weight × root blend
         self.rest = rest  # float32 (M, 3) rest positions
-        self.axis = axis  # float64 (m, 3) rest control axis
         self.tangent, self.side, self.up = frame
         self.root = root  # float64 (3,) where the fin meets the body
-        self.amplitude_scale = (
-            amplitude_scale  # UNDULATE: fin height / base length (amplitude is per height)
+        outward = tip - root
+        self.feather_on_power, self.feather_sign = _blade_facing(rest, outward, frame, kn)
+        height = float(reach.max()) if len(reach) else 1.0
+        self.binding = kn.FinPart(
+            rest,
+            np.ascontiguousarray(reach, dtype=np.float64),
+            np.ascontiguousarray(weights, dtype=np.float64),
+            np.asarray(root, dtype=np.float64),
+            np.asarray(outward, dtype=np.float64),
+            *frame,
+            max(height, 1e-9),
+            max(base[1] - base[0], 1e-9),
+            base[0],
         )
-        self.binding = kn.ffd_bind(axis, rest, up=_up_hint(axis, self.up, self.side))
-        self.feather_on_power, self.feather_sign = _blade_facing(rest, axis, frame, kn)
         self.out = np.empty_like(rest)
-        self.shift = np.empty_like(rest)
 
 
 def _up_hint(axis, up, side):
@@ -42,10 +46,9 @@ def _up_hint(axis, up, side):
     return up if abs(float(direction @ up)) < 0.9 else side
 
 
-def _blade_facing(rest, axis, frame, kn):
+def _blade_facing(rest, direction, frame, kn):
     """(feather on the power stroke?, roll sign): compares the modelled blade's normal
     (least-variance direction of its vertices) with the flap stroke direction."""
-    direction = axis[-1] - axis[0]
     stroke = kn.swim_flap_stroke_direction(direction, *frame)
     centred = rest.astype(np.float64) - rest.mean(axis=0)
     normal = np.linalg.svd(centred, full_matrices=False)[2][-1]
@@ -91,19 +94,16 @@ def _outward(kind, centroid_offset, frame):
     return across / norm
 
 
-def distance_from_body(points, body_points):
-    """Each fin point's distance to the nearest body vertex (body = vertices in no fin),
-    searched among the body vertices near the fin only."""
-    lo, hi = points.min(axis=0), points.max(axis=0)
-    margin = 0.25 * float(np.linalg.norm(hi - lo)) + 1e-9
-    near = body_points[np.all((body_points >= lo - margin) & (body_points <= hi + margin), axis=1)]
-    if len(near) == 0:
-        return None
-    tree = kdtree.KDTree(len(near))
-    for i, p in enumerate(near):
-        tree.insert(p, i)
-    tree.balance()
-    return np.array([tree.find(p)[2] for p in points])
+def fin_reach(rest, edges, in_fin, body_length, kn):
+    """Per vertex: how far across its fin it stands from the body (path length along the
+    fin's edges from where it meets the body, smoothed; 0 on the body). Native."""
+    reach, _source = kn.swim_fin_reach(
+        np.ascontiguousarray(rest, dtype=np.float32),
+        edges,
+        np.ascontiguousarray(in_fin, dtype=bool),
+        1e-4 * body_length,
+    )
+    return reach
 
 
 def split_sides(kind, points, axis_point, frame):
@@ -119,7 +119,7 @@ def split_sides(kind, points, axis_point, frame):
     return whole
 
 
-def build_parts(fin_index, fin, group_weights, verts, body_axis, up, kn, body_points=None):
+def build_parts(fin_index, fin, group_weights, verts, body_axis, up, kn, reach_all=None):
     """FinParts of one fin setting; raises ValueError with a readable reason."""
     indices = np.flatnonzero(group_weights > 0.0)
     if len(indices) < 4:
@@ -133,54 +133,35 @@ def build_parts(fin_index, fin, group_weights, verts, body_axis, up, kn, body_po
         part_indices = indices[mask]
         centroid = points.mean(axis=0)
         frame, axis_point = body_frame_at(centroid, body_axis, up)
-        # How far out each vertex is: its distance from the body where the fin has body
-        # vertices around it (so the root row, on the body, is exactly 0), else its
-        # reach along the fin kind's outward direction.
-        reach = (
-            distance_from_body(points, body_points)
-            if body_points is not None and len(body_points)
-            else None
-        )
+        # How far out each vertex is: its (smoothed) path across the fin from where it
+        # meets the body (fin_reach; 0 at the root), else its reach along the kind's
+        # outward direction.
+        reach = None
+        if reach_all is not None and np.all(np.isfinite(reach_all[part_indices])):
+            reach = reach_all[part_indices]
         if reach is None:
             reach = (points - centroid) @ _outward(fin.kind, centroid - axis_point, frame)
         lo, hi = float(reach.min()), float(reach.max())
         if hi - lo < 1e-6:
             raise ValueError(f"vertex group '{fin.vertex_group}' does not stand out from the body")
         r = (reach - lo) / (hi - lo)  # 0 at the root, 1 at the fin's outer edge
-        root_set = points[r <= 0.1]
-        tip_set = points[r >= 0.9]
-        root = root_set.mean(axis=0)
-        if fin.motion == "UNDULATE":
-            along = (points - centroid) @ frame[0]
-            front, back = float(along.min()), float(along.max())
-            if back - front < 1e-6:
-                raise ValueError(f"vertex group '{fin.vertex_group}' has no length along the body")
-            middle = centroid - (centroid @ frame[0]) * frame[0]
-            stations = np.linspace(front, back, UNDULATE_POINTS) + centroid @ frame[0]
-            axis = middle[None, :] + stations[:, None] * frame[0][None, :]
-            amplitude_scale = (hi - lo) / (back - front)
-        else:
-            amplitude_scale = 1.0
-            tip = tip_set.mean(axis=0)
-            if np.linalg.norm(tip - root) < 1e-6:
-                raise ValueError(
-                    f"vertex group '{fin.vertex_group}' has no length from root to tip"
-                )
-            axis = root[None, :] + np.array(ROOT_CLUSTER)[:, None] * (tip - root)[None, :]
-        blend = _smoothstep(r / max(fin.root_blend, 1e-3))
-        weights = (group_weights[part_indices] * blend).astype(np.float32)[:, None]
+        root = points[r <= 0.1].mean(axis=0)
+        tip = points[r >= 0.9].mean(axis=0)
+        if np.linalg.norm(tip - root) < 1e-6:
+            tip = root + (hi - lo) * _outward(fin.kind, centroid - axis_point, frame)
+        along = points @ frame[0]
+        base = (float(along.min()), float(along.max()))
+        if fin.motion == "UNDULATE" and base[1] - base[0] < 1e-6:
+            raise ValueError(f"vertex group '{fin.vertex_group}' has no length along the body")
+        # The motion fades in over the first root_blend of the fin (SEEDS §1: the root
+        # must not move, or the fin tears from the body).
+        # An undulation's sideways wave fades in over the whole fin height: over a short
+        # root band it would shear the fin's base (its amplitude is a share of the height).
+        span = 1.0 if fin.motion == "UNDULATE" else fin.root_blend
+        blend = _smoothstep(r / max(span, 1e-3))
+        weights = group_weights[part_indices] * blend
         rest = np.ascontiguousarray(verts[part_indices], dtype=np.float32)
         parts.append(
-            FinPart(
-                fin_index,
-                part_indices,
-                weights,
-                rest,
-                np.ascontiguousarray(axis),
-                frame,
-                root,
-                amplitude_scale,
-                kn,
-            )
+            FinPart(fin_index, part_indices, weights, rest, reach - lo, root, tip, frame, base, kn)
         )
     return parts

@@ -10,6 +10,7 @@ from . import runtime, visibility
 
 @persistent
 def on_frame_change(scene, depsgraph=None):
+    runtime.separate_linked_duplicates(scene)
     for obj in scene.objects:
         if obj.type != "MESH" or not runtime.is_live(obj):
             continue

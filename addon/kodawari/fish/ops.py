@@ -1,8 +1,5 @@
 """Operators: add / remove the swim, add / find fins, flip the head, bake."""
 
-# bl_options sets are Blender's class-attribute convention, never mutated.
-# ruff: noqa: RUF012
-
 import types
 
 import bpy
@@ -41,7 +38,9 @@ class KODAWARI_OT_swim_add(bpy.types.Operator):
         description="Which way the head points (Auto: guessed from the shape)",
     )
     preset: EnumProperty(
-        name="Preset", items=[(k, *presets.LABELS[k]) for k in presets.ORDER], default="CARANGIFORM",
+        name="Preset",
+        items=[(k, *presets.LABELS[k]) for k in presets.ORDER],
+        default="CARANGIFORM",
         description="A kind of swimmer: sets the body wave and the fins' motions",
     )
     frequency: FloatProperty(
@@ -100,6 +99,8 @@ class KODAWARI_OT_swim_add(bpy.types.Operator):
             obj.shape_key_add(name="Basis", from_mix=False)
             key = obj.shape_key_add(name=SHAPE_KEY, from_mix=False)
             key.value = 1.0
+            # Edit Mode edits the active key: keep it on the Basis, the rest shape.
+            obj.active_shape_key_index = 0
             settings.enabled = True
         # The handler writes the shape key on frame changes; renders must wait for it.
         context.scene.render.use_lock_interface = True
@@ -175,9 +176,14 @@ def _fin_kind_items():
     return [(k, k.title(), f"{k.title()} fin") for k in presets.FIN_KINDS]
 
 
-def _check_fin(obj, group_name, kind):
-    """(error, None) or (None, weights) for a new fin, validated by binding it on trial."""
-    error, weights = validate.fin_group(obj, group_name, obj.kodawari_swim.fins)
+def _check_fin(obj, group_name, kind, known_weights=None, reach=None):
+    """(error, None) or (None, weights) for a new fin, validated by binding it on trial.
+    known_weights: {group: weights} already in hand (Find Fins), read from the mesh
+    otherwise; reach: fin_setup.fin_reach over every fin, when already computed."""
+    known_weights = known_weights or {}
+    error, weights = validate.fin_group(
+        obj, group_name, obj.kodawari_swim.fins, known_weights.get(group_name)
+    )
     if error:
         return error, None
     settings = obj.kodawari_swim
@@ -186,20 +192,25 @@ def _check_fin(obj, group_name, kind):
         vertex_group=group_name, kind=kind, motion=motion, root_blend=0.35
     )
     try:
-        rig = runtime.get_rig(obj)
-        in_fin = weights > 0
-        for fin in settings.fins:
-            in_fin |= bulk.vertex_group_weights(obj, fin.vertex_group) > 0
-        body_points = rig.rest[~in_fin].astype(np.float64)
-        fin_setup.build_parts(
-            0, trial, weights, rig.rest, rig.axis_rest, rig.up, native.module(), body_points
-        )
+        rig = runtime.body_rig(obj)
+        kn = native.module()
+        if reach is None:
+            in_fin = weights > 0
+            for fin in settings.fins:
+                other = known_weights.get(fin.vertex_group)
+                if other is None:
+                    other = bulk.vertex_group_weights(obj, fin.vertex_group)
+                in_fin |= other > 0
+            reach = fin_setup.fin_reach(
+                rig.rest, finder.mesh_edges(obj.data), in_fin, rig.body_length, kn
+            )
+        fin_setup.build_parts(0, trial, weights, rig.rest, rig.axis_rest, rig.up, kn, reach)
     except ValueError as exc:
         return f"Cannot bind fin '{group_name}': {exc}", None
     return None, weights
 
 
-def add_fin(obj, group_name, kind):
+def add_fin(obj, group_name, kind, rebind=True):
     settings = obj.kodawari_swim
     motion, amplitude, lag, feathering = presets.fin_defaults(settings.preset, kind)
     with runtime.batch(obj):
@@ -212,7 +223,8 @@ def add_fin(obj, group_name, kind):
         fin.phase_lag = lag
         fin.feathering = feathering
         settings.fin_index = len(settings.fins) - 1
-    runtime.rebind(obj)
+    if rebind:
+        runtime.rebind(obj)
     return fin
 
 
@@ -232,7 +244,9 @@ class KODAWARI_OT_swim_fin_add(bpy.types.Operator):
     bl_options = {"REGISTER", "UNDO"}
 
     vertex_group: StringProperty(name="Vertex Group", description="The fin's vertices")
-    kind: EnumProperty(name="Kind", items=_fin_kind_items(), default="PECTORAL", description="Which fin this is")
+    kind: EnumProperty(
+        name="Kind", items=_fin_kind_items(), default="PECTORAL", description="Which fin this is"
+    )
 
     def invoke(self, context, event):
         obj = _active_mesh(context)
@@ -287,36 +301,114 @@ class KODAWARI_OT_swim_fin_remove(bpy.types.Operator):
 
 
 class KODAWARI_OT_swim_fin_find(bpy.types.Operator):
-    """Find fins from the geometry (thin parts away from the body's core), make vertex groups and add them"""
+    """Find fins from the geometry (parts standing out of the body's cross-section), make vertex groups and add them"""
 
     bl_idname = "kodawari.swim_fin_find"
     bl_label = "Find Fins"
     bl_options = {"REGISTER", "UNDO"}
 
-    def execute(self, context):
+    _search = None
+    _timer = None
+
+    def _start(self, context):
         obj = _active_mesh(context)
         error = _needs_swim(obj)
         if error:
             self.report({"ERROR"}, error)
-            return {"CANCELLED"}
-        rig = runtime.get_rig(obj)
-        found = finder.find_fins(obj, rig)
+            return None
+        return finder.FinSearch(obj, runtime.get_rig(obj))
+
+    def _finish(self, context):
+        obj = _active_mesh(context)
+        found = self._search.found()
         if not found:
             self.report(
-                {"WARNING"}, f"No fins found on '{obj.name}': no thin parts stand out from the body"
+                {"WARNING"}, f"No fins found on '{obj.name}': nothing stands out of the body"
             )
             return {"CANCELLED"}
         added = []
-        for name, kind, indices in found:
-            group = obj.vertex_groups.get(name) or obj.vertex_groups.new(name=name)
-            group.add([int(i) for i in indices], 1.0, "REPLACE")
-            if not any(f.vertex_group == name for f in obj.kodawari_swim.fins):
-                error, _ = _check_fin(obj, name, kind)
-                if error is None:
-                    add_fin(obj, name, kind)
-            added.append(f"{name} ({len(indices)} vertices)")
+        known = {}
+        count = len(obj.data.vertices)
+        for name, _kind, indices in found:
+            group = obj.vertex_groups.get(name)
+            if group is not None:  # a search run again replaces what it found before
+                obj.vertex_groups.remove(group)
+            obj.vertex_groups.new(name=name).add(indices.tolist(), 1.0, "REPLACE")
+            known[name] = np.zeros(count, dtype=np.float32)
+            known[name][indices] = 1.0
+        # The groups' weights are known: bind once at the end, never re-read per vertex;
+        # every fin's reach across itself comes from one pass over all of them.
+        rig = runtime.body_rig(obj)
+        in_fin = np.zeros(count, dtype=bool)
+        for weights in known.values():
+            in_fin |= weights > 0
+        for fin in obj.kodawari_swim.fins:
+            if fin.vertex_group not in known:
+                in_fin |= bulk.vertex_group_weights(obj, fin.vertex_group) > 0
+        reach = fin_setup.fin_reach(
+            rig.rest, self._search.edges, in_fin, rig.body_length, native.module()
+        )
+        with runtime.batch(obj):
+            for name, kind, indices in found:
+                if not any(f.vertex_group == name for f in obj.kodawari_swim.fins):
+                    error, _ = _check_fin(obj, name, kind, known, reach)
+                    if error is None:
+                        add_fin(obj, name, kind, rebind=False)
+                added.append(f"{name} ({len(indices)} vertices)")
+        runtime.rebind(obj, known)
         self.report({"INFO"}, f"Found {len(found)} fin(s) on '{obj.name}': " + ", ".join(added))
         return {"FINISHED"}
+
+    def execute(self, context):
+        self._search = self._start(context)
+        if self._search is None:
+            return {"CANCELLED"}
+        while not self._search.done:
+            self._search.step()
+        return self._finish(context)
+
+    def invoke(self, context, event):
+        if bpy.app.background:
+            return self.execute(context)
+        self._search = self._start(context)
+        if self._search is None:
+            return {"CANCELLED"}
+        wm = context.window_manager
+        wm.progress_begin(0, self._search.steps)
+        self._timer = wm.event_timer_add(0.001, window=context.window)
+        wm.modal_handler_add(self)
+        return {"RUNNING_MODAL"}
+
+    def modal(self, context, event):
+        if event.type == "ESC":
+            self._end(context)
+            self.report({"WARNING"}, "Find Fins cancelled: nothing was changed")
+            return {"CANCELLED"}
+        if event.type != "TIMER":
+            return {"RUNNING_MODAL"}
+        try:
+            self._search.step()
+        except ValueError as exc:
+            self._end(context)
+            self.report({"ERROR"}, f"Find Fins failed, nothing was changed: {exc}")
+            return {"CANCELLED"}
+        context.window_manager.progress_update(self._search.steps_done)
+        if context.area:
+            context.area.header_text_set(
+                f"Finding fins: {self._search.next_vertex:,}/{len(self._search.vertices):,} vertices"
+                " (Esc cancels)"
+            )
+        if not self._search.done:
+            return {"RUNNING_MODAL"}
+        self._end(context)
+        return self._finish(context)
+
+    def _end(self, context):
+        wm = context.window_manager
+        wm.event_timer_remove(self._timer)
+        wm.progress_end()
+        if context.area:
+            context.area.header_text_set(None)
 
 
 class KODAWARI_OT_swim_flip_head(bpy.types.Operator):

@@ -11,9 +11,15 @@ from bpy.app.translations import pgettext_iface as iface_
 from .. import in_use, problems
 from . import overlay, visibility
 
-MODIFIER_ICONS = {"ARMATURE": "MOD_ARMATURE", "SUBSURF": "MOD_SUBSURF", "MIRROR": "MOD_MIRROR",
-                  "MESH_CACHE": "MOD_MESHDEFORM", "SOLIDIFY": "MOD_SOLIDIFY", "BEVEL": "MOD_BEVEL",
-                  "NODES": "GEOMETRY_NODES"}
+MODIFIER_ICONS = {
+    "ARMATURE": "MOD_ARMATURE",
+    "SUBSURF": "MOD_SUBSURF",
+    "MIRROR": "MOD_MIRROR",
+    "MESH_CACHE": "MOD_MESHDEFORM",
+    "SOLIDIFY": "MOD_SOLIDIFY",
+    "BEVEL": "MOD_BEVEL",
+    "NODES": "GEOMETRY_NODES",
+}
 
 
 class KODAWARI_UL_swim_fins(bpy.types.UIList):
@@ -90,7 +96,9 @@ class KODAWARI_PT_swim(_SwimPanel, bpy.types.Panel):
         if settings.baked != "NONE":
             col = layout.column()
             target = settings.bl_rna.properties["baked"].enum_items[settings.baked].name
-            col.label(text=iface_("Baked to {}").format(iface_(target)), icon="CHECKMARK", translate=False)
+            col.label(
+                text=iface_("Baked to {}").format(iface_(target)), icon="CHECKMARK", translate=False
+            )
             if settings.baked == "MESH_CACHE":
                 col.label(text=settings.cache_path, icon="FILE_CACHE", translate=False)
             col = layout.column(align=True)  # stacked: side by side, "Remove Fish Swim" is cut off
@@ -101,7 +109,9 @@ class KODAWARI_PT_swim(_SwimPanel, bpy.types.Panel):
         if problem:
             box = layout.box()
             box.alert = True
-            box.label(text=iface_("Not swimming: {}").format(problem), icon="ERROR", translate=False)
+            box.label(
+                text=iface_("Not swimming: {}").format(problem), icon="ERROR", translate=False
+            )
         layout.label(text="Runs before all modifiers", icon="SORT_ASC")
         col = layout.column()
         col.prop(settings, "preset")
@@ -119,8 +129,12 @@ class KODAWARI_PT_swim(_SwimPanel, bpy.types.Panel):
         col.prop(settings, "bend")
         layout.separator()
         col = layout.column(align=True)
-        col.operator("kodawari.swim_bake", text="Bake to Mesh Cache", icon="FILE_CACHE").target = "MESH_CACHE"
-        col.operator("kodawari.swim_bake", text="Bake to Shape Keys", icon="SHAPEKEY_DATA").target = "SHAPE_KEYS"
+        col.operator(
+            "kodawari.swim_bake", text="Bake to Mesh Cache", icon="FILE_CACHE"
+        ).target = "MESH_CACHE"
+        col.operator(
+            "kodawari.swim_bake", text="Bake to Shape Keys", icon="SHAPEKEY_DATA"
+        ).target = "SHAPE_KEYS"
         row = layout.row(align=True)
         row.operator("kodawari.swim_apply", text="Apply", icon="CHECKMARK")
         row.operator("kodawari.swim_remove", text="Remove", icon="X")
@@ -171,7 +185,9 @@ class KODAWARI_PT_swim_fins(_SwimPanel, bpy.types.Panel):
         obj = context.object
         settings = obj.kodawari_swim
         row = layout.row()
-        row.template_list("KODAWARI_UL_swim_fins", "", settings, "fins", settings, "fin_index", rows=3)
+        row.template_list(
+            "KODAWARI_UL_swim_fins", "", settings, "fins", settings, "fin_index", rows=3
+        )
         col = row.column(align=True)
         col.operator("kodawari.swim_fin_add", text="", icon="ADD")
         col.operator("kodawari.swim_fin_remove", text="", icon="REMOVE")
@@ -226,5 +242,12 @@ class KODAWARI_PT_swim_add(bpy.types.Panel):
         self.layout.operator("kodawari.swim_add", icon="MOD_WAVE")
 
 
-CLASSES = (KODAWARI_UL_swim_fins, KODAWARI_PT_swim_add, KODAWARI_PT_swim, KODAWARI_PT_swim_body, KODAWARI_PT_swim_travel,
-           KODAWARI_PT_swim_fins, KODAWARI_PT_swim_order)
+CLASSES = (
+    KODAWARI_UL_swim_fins,
+    KODAWARI_PT_swim_add,
+    KODAWARI_PT_swim,
+    KODAWARI_PT_swim_body,
+    KODAWARI_PT_swim_travel,
+    KODAWARI_PT_swim_fins,
+    KODAWARI_PT_swim_order,
+)

@@ -2,8 +2,10 @@
 
 Body values are fractions of body length L; fin amplitudes are radians for FLAP,
 UP_DOWN and TWIST and, for UNDULATE, the sideways excursion as a fraction of the fin's height.
-Sources: docs/algorithms.md §2.6-§2.7 (Bainbridge 1958; tail peak ≈ 0.1 L at cruise,
-maximum ≈ L/5; Strouhal 0.25-0.3 for carangiform swimmers) and the issue's preset list.
+Amplitudes are CRUISE values (docs/algorithms.md §2.7): a tail peak of
+0.06 L is a peak-to-peak of 0.12 L, inside the 0.1-0.13 L of cruising fish (Webb 1975;
+Videler 1993, Fish Swimming); Bainbridge's (1958) maximum, about L/5 peak-to-peak
+(peak 0.1 L), stays reachable with the Amplitude setting.
 """
 
 import math
@@ -15,19 +17,19 @@ BODY = {
     "ANGUILLIFORM": {
         "frequency": 1.2,
         "wavelength": 0.6,
-        "amplitude": 0.08,
-        "amplitude_head": 0.04,
+        "amplitude": 0.05,
+        "amplitude_head": 0.025,
         "envelope_start": 0.0,
         "envelope_power": 1.0,
         "bend": "LATERAL",
         "control_points": 16,
     },
-    # Rear third of the body plus caudal fin, λ ≈ 1 L, tail ≈ 0.1 L (jack, mackerel).
+    # Rear third of the body plus caudal fin, λ ≈ 1 L, cruise tail peak 0.06 L (jack, mackerel).
     "CARANGIFORM": {
         "frequency": 2.0,
         "wavelength": 1.0,
-        "amplitude": 0.1,
-        "amplitude_head": 0.01,
+        "amplitude": 0.06,
+        "amplitude_head": 0.006,
         "envelope_start": 0.45,
         "envelope_power": 1.6,
         "bend": "LATERAL",
@@ -37,8 +39,8 @@ BODY = {
     "THUNNIFORM": {
         "frequency": 2.5,
         "wavelength": 1.25,
-        "amplitude": 0.09,
-        "amplitude_head": 0.005,
+        "amplitude": 0.055,
+        "amplitude_head": 0.003,
         "envelope_start": 0.6,
         "envelope_power": 2.2,
         "bend": "LATERAL",
@@ -81,8 +83,8 @@ BODY = {
     "CETACEAN": {
         "frequency": 1.5,
         "wavelength": 1.25,
-        "amplitude": 0.09,
-        "amplitude_head": 0.01,
+        "amplitude": 0.06,
+        "amplitude_head": 0.006,
         "envelope_start": 0.5,
         "envelope_power": 2.0,
         "bend": "DORSOVENTRAL",

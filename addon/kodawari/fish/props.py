@@ -86,8 +86,12 @@ class KodawariSwimFin(bpy.types.PropertyGroup):
         update=_rebind,
         description="How the fin moves",
     )
-    enabled: BoolProperty(name="Enabled", default=True, update=_refresh,
-                          description="Move this fin (off: it follows the body only)")
+    enabled: BoolProperty(
+        name="Enabled",
+        default=True,
+        update=_refresh,
+        description="Move this fin (off: it follows the body only)",
+    )
     amplitude: FloatProperty(
         name="Amplitude",
         description="How far the fin swings to each side. Undulate: the sideways reach as a share of the fin's height (1 rad = 1 height)",
@@ -198,7 +202,7 @@ class KodawariSwimSettings(bpy.types.PropertyGroup):
         description="How far the tail tip swings to each side, as a share of the body length",
         subtype="FACTOR",
         precision=3,
-        default=0.1,
+        default=0.06,
         min=0.0,
         soft_max=0.3,
         max=1.0,
@@ -209,7 +213,7 @@ class KodawariSwimSettings(bpy.types.PropertyGroup):
         description="How far the snout swings to each side, as a share of the body length",
         subtype="FACTOR",
         precision=3,
-        default=0.01,
+        default=0.006,
         min=0.0,
         soft_max=0.3,
         max=1.0,
@@ -259,8 +263,23 @@ class KodawariSwimSettings(bpy.types.PropertyGroup):
         name="Speed",
         items=[
             ("NONE", "None", "Swim on the spot"),
-            ("BAINBRIDGE", "From Tail Beat", "Faster with a faster tail beat, as measured on real fish (Bainbridge 1958)"),
-            ("STROUHAL", "From Tail Swing", "Faster with a wider, faster tail swing (Strouhal number)"),
+            (
+                "BAINBRIDGE",
+                "From Tail Beat",
+                (
+                    "Faster with a faster tail beat, as measured on real fish (Bainbridge 1958: "
+                    "V = L(3f - 4)/4, fitted above about 5 Hz; where it leaves Strouhal 0.2-0.4, "
+                    "the Strouhal speed). Fin swimmers: half a body length per fin beat"
+                ),
+            ),
+            (
+                "STROUHAL",
+                "From Tail Swing",
+                (
+                    "Faster with a wider, faster tail swing (Strouhal number). Fin swimmers (no body "
+                    "wave): half a body length per fin beat"
+                ),
+            ),
         ],
         default="NONE",
         description="Whether and how the fish moves forward as it swims",
@@ -283,7 +302,9 @@ class KodawariSwimSettings(bpy.types.PropertyGroup):
         subtype="FACTOR",
         update=_refresh,
     )
-    fins: CollectionProperty(type=KodawariSwimFin, name="Fins", description="The fins that move on their own")
+    fins: CollectionProperty(
+        type=KodawariSwimFin, name="Fins", description="The fins that move on their own"
+    )
     fin_index: IntProperty(name="Active Fin", default=0, description="The fin shown below the list")
     show_axis: BoolProperty(
         name="Show Axis", description="Draw the control axis in the viewport", default=True
@@ -294,8 +315,10 @@ class KodawariSwimSettings(bpy.types.PropertyGroup):
         name="Head Guess", description="Which way Add Fish Swim guessed the head points, and why"
     )
     rest_delta_location: FloatVectorProperty(
-        name="Rest Delta Location", size=3, subtype="TRANSLATION",
-        description="Where the fish was before it swam off (restored when the swim is removed)"
+        name="Rest Delta Location",
+        size=3,
+        subtype="TRANSLATION",
+        description="Where the fish was before it swam off (restored when the swim is removed)",
     )
     baked: EnumProperty(
         name="Baked",
@@ -308,6 +331,8 @@ class KodawariSwimSettings(bpy.types.PropertyGroup):
         description="Whether the swim is live or baked, and to what",
     )
     cache_path: StringProperty(
-        name="Cache Path", subtype="FILE_PATH", options=cache_paths.RELATIVE_PATH_OPTIONS,
+        name="Cache Path",
+        subtype="FILE_PATH",
+        options=cache_paths.RELATIVE_PATH_OPTIONS,
         description="The baked point cache file",
     )

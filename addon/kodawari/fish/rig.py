@@ -26,6 +26,25 @@ def rest_positions(obj):
     return bulk.vertex_positions(mesh)
 
 
+FINGERPRINT_SAMPLES = 32
+
+
+def rest_fingerprint(obj):
+    """A cheap check (about 40 attribute reads, whatever the vertex count) that the rest
+    shape is the one the rig was bound to: where the rest positions live in memory
+    (leaving Edit Mode rewrites them) and a few of them spread over the mesh (Apply
+    Scale moves them all in place)."""
+    mesh = obj.data
+    keys = mesh.shape_keys
+    data = keys.reference_key.data if keys is not None and keys.reference_key else mesh.vertices
+    n = len(data)
+    if n == 0:
+        return (0,)
+    step = max(1, n // FINGERPRINT_SAMPLES)
+    sample = tuple(tuple(data[i].co) for i in range(0, n, step))
+    return (data[0].as_pointer(), sample)
+
+
 def binding_signature(obj, settings):
     """What the binding depends on; a change means rebuild."""
     fins = tuple(
@@ -35,10 +54,13 @@ def binding_signature(obj, settings):
 
 
 class SwimRig:
-    def __init__(self, obj, settings):
+    def __init__(self, obj, settings, known_weights=None):
+        """known_weights: {vertex group: float32 (N,)} already in hand (Find Fins), read
+        from the mesh otherwise."""
         kn = native.module()
         self.kn = kn
         self.signature = binding_signature(obj, settings)
+        self.fingerprint = rest_fingerprint(obj)
         self.mesh_pointer = obj.data.as_pointer()
         self.rest = rest_positions(obj)
         self.count = len(self.rest)
@@ -50,15 +72,22 @@ class SwimRig:
         self.positions = np.empty_like(self.rest)
         self.axis = self.axis_rest.copy()
         self.parts = []
+        known_weights = known_weights or {}
         weights = {
-            f.vertex_group: bulk.vertex_group_weights(obj, f.vertex_group)
+            f.vertex_group: known_weights[f.vertex_group]
+            if f.vertex_group in known_weights
+            else bulk.vertex_group_weights(obj, f.vertex_group)
             for f in settings.fins
             if f.enabled
         }
         in_fin = np.zeros(self.count, dtype=bool)
         for w in weights.values():
             in_fin |= w > 0
-        body_points = self.rest[~in_fin].astype(np.float64)
+        reach = None
+        if in_fin.any() and not in_fin.all():
+            edges = np.empty((len(obj.data.edges), 2), dtype=np.int32)
+            obj.data.edges.foreach_get("vertices", edges.reshape(-1))
+            reach = fin_setup.fin_reach(self.rest, edges, in_fin, self.body_length, kn)
         for index, fin in enumerate(settings.fins):
             if fin.enabled:
                 self.parts.extend(
@@ -70,7 +99,7 @@ class SwimRig:
                         self.axis_rest,
                         self.up,
                         kn,
-                        body_points,
+                        reach,
                     )
                 )
         # Four probe points per fin part (root and one step along its tangent, side, up):
@@ -108,56 +137,30 @@ class SwimRig:
             preserve_length=settings.preserve_length,
         )
 
-    def _root_rotations(self):
-        """Rotation (3, 3) of the body at each fin part's root, rest → now."""
-        p = self.probes_out.astype(np.float64).reshape(-1, 4, 3)
-        rest = self.probes_rest.astype(np.float64).reshape(-1, 4, 3)
-        rotations = []
-        for k in range(len(p)):
-            moved = (p[k, 1:] - p[k, 0]).T  # columns: tangent, side, up after the bend
-            before = (rest[k, 1:] - rest[k, 0]).T
-            # Nearest rotation to moved · before⁻¹ (polar decomposition by SVD).
-            u, _, vt = np.linalg.svd(moved @ np.linalg.inv(before))
-            r = u @ vt
-            if np.linalg.det(r) < 0:
-                u[:, -1] *= -1
-                r = u @ vt
-            rotations.append(r)
-        return rotations
-
     def evaluate(self, settings, phase, rest_axis=None):
         """Deformed positions float32 (N, 3) for the phase (radians, accumulated); `rest_axis`
         replaces the straight rest axis (a spine bent along a path) before the wave."""
-        kn = self.kn
         self.axis = self.body_axis(settings, phase, rest_axis)
         self.binding.deform(self.axis, self.positions)
         if not self.parts:
             return self.positions
         self.probe_binding.deform(self.axis, self.probes_out)
-        rotations = self._root_rotations()
-        for part, rotation in zip(self.parts, rotations):
+        for k, part in enumerate(self.parts):
             fin = settings.fins[part.fin_index]
-            if fin.amplitude == 0.0:
+            if fin.amplitude == 0.0 and (fin.motion != "FLAP" or fin.feathering == 0.0):
                 continue
-            fin_phase = phase * fin.frequency_ratio - fin.phase_lag
-            points, twist = kn.swim_fin_axis(
-                part.axis,
-                part.tangent,
-                part.side,
-                part.up,
+            # The core swings each vertex about its own root, faded in from the body, and
+            # turns the result with the body's rotation at the root (from the probes).
+            part.binding.displace(
                 fin.motion,
-                fin.amplitude * part.amplitude_scale,
-                fin_phase,
-                feathering=fin.feathering * part.feather_sign,
-                wavelength=fin.wavelength,
-                fixed_count=3,
-                feather_on_power=part.feather_on_power,
+                fin.amplitude,
+                phase * fin.frequency_ratio - fin.phase_lag,
+                fin.feathering * part.feather_sign,
+                fin.wavelength,
+                part.feather_on_power,
+                self.probes_rest[4 * k : 4 * k + 4],
+                self.probes_out[4 * k : 4 * k + 4],
+                part.out,
             )
-            part.binding.deform(points, part.out, twist=twist)
-            # The fin's own motion (rest space), turned with the body at its root and
-            # faded in from the root: root vertices keep the body's position exactly.
-            np.subtract(part.out, part.rest, out=part.shift)
-            np.matmul(part.shift, rotation.T.astype(np.float32), out=part.out)
-            part.out *= part.weights
             self.positions[part.indices] += part.out
         return self.positions

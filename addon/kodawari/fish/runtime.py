@@ -33,19 +33,32 @@ def forget(obj=None):
         _rigs.pop(_key(obj), None)
 
 
-def get_rig(obj, build=True):
+def get_rig(obj, build=True, known_weights=None):
     """The object's bound rig, rebuilt when its binding inputs changed."""
     settings = obj.kodawari_swim
     rig = _rigs.get(_key(obj))
     if rig is not None and (
         rig.signature != rig_module.binding_signature(obj, settings)
         or rig.mesh_pointer != obj.data.as_pointer()
+        or rig.fingerprint != rig_module.rest_fingerprint(obj)  # Apply Scale, Edit-Mode edits
     ):
         rig = None
     if rig is None and build:
-        rig = rig_module.SwimRig(obj, settings)
+        rig = rig_module.SwimRig(obj, settings, known_weights)
         _rigs[_key(obj)] = rig
     return rig
+
+
+def body_rig(obj):
+    """A rig whose rest shape and body axis are current (its fins may be out of date):
+    what checking a new fin needs, without rebinding every fin."""
+    rig = _rigs.get(_key(obj))
+    if rig is not None and (
+        rig.signature[:3] != rig_module.binding_signature(obj, obj.kodawari_swim)[:3]
+        or rig.mesh_pointer != obj.data.as_pointer()
+    ):
+        rig = None
+    return rig if rig is not None else get_rig(obj)
 
 
 @contextlib.contextmanager
@@ -130,6 +143,36 @@ def refresh(obj):
         problems.clear(obj, "swim")
 
 
-def rebind(obj):
+def rebind(obj, known_weights=None):
+    if _key(obj) in _batch_depth:
+        # Several settings change together (Find Fins adds fins one by one): the rig's
+        # signature tells get_rig to rebuild once they are done; body_rig keeps serving
+        # the rest shape meanwhile instead of rebuilding it per fin.
+        return
     forget(obj)
+    if known_weights and is_live(obj):
+        get_rig(obj, known_weights=known_weights)
     refresh(obj)
+
+
+def separate_linked_duplicates(scene):
+    """Linked duplicates (Alt-D) share one mesh and so one swim shape key: each would
+    overwrite the other. Give every live swimmer after the first its own copy of the
+    mesh (what Object > Relations > Make Single User does) so each swims with its own
+    settings, and say so in the console."""
+    owners = {}
+    for obj in sorted(scene.objects, key=lambda o: o.name):
+        if obj.type != "MESH" or not is_live(obj) or obj.data.library is not None:
+            continue
+        owner = owners.setdefault(obj.data.as_pointer(), obj)
+        if owner is not obj:
+            try:
+                obj.data = obj.data.copy()
+            except (RuntimeError, AttributeError) as exc:  # e.g. a write-protected object
+                problems.report(obj, "swim", exc)
+                continue
+            forget(obj)
+            print(
+                f"Kodawari Swim: '{obj.name}' shared its mesh with '{owner.name}' (a linked "
+                f"duplicate); it now has its own copy so each swims with its own settings"
+            )

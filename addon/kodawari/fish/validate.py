@@ -47,7 +47,7 @@ def frequency(value):
     return None
 
 
-def fin_group(obj, group_name, existing_fins):
+def fin_group(obj, group_name, existing_fins, weights=None):
     """(error, weights): the vertex group must exist, hold vertices and not be most of the mesh."""
     if not group_name:
         return "Give the vertex group that holds the fin's vertices", None
@@ -56,7 +56,8 @@ def fin_group(obj, group_name, existing_fins):
         return f"'{obj.name}' has no vertex group '{group_name}' (groups: {known})", None
     if any(f.vertex_group == group_name for f in existing_fins):
         return f"Vertex group '{group_name}' is already a fin of '{obj.name}'", None
-    weights = bulk.vertex_group_weights(obj, group_name)
+    if weights is None:
+        weights = bulk.vertex_group_weights(obj, group_name)
     members = int(np.count_nonzero(weights > 0))
     if members == 0:
         return f"Vertex group '{group_name}' is empty: assign the fin's vertices to it first", None

@@ -48,7 +48,16 @@ def set_rendering(scene, rendering):
 def draw_toggles(layout, settings):
     """The eye and camera toggles of a modifier header."""
     row = layout.row(align=True)
-    row.prop(settings, "enabled", text="", icon="RESTRICT_VIEW_OFF" if settings.enabled else "RESTRICT_VIEW_ON")
-    row.prop(settings, "show_render", text="",
-             icon="RESTRICT_RENDER_OFF" if settings.show_render else "RESTRICT_RENDER_ON")
+    row.prop(
+        settings,
+        "enabled",
+        text="",
+        icon="RESTRICT_VIEW_OFF" if settings.enabled else "RESTRICT_VIEW_ON",
+    )
+    row.prop(
+        settings,
+        "show_render",
+        text="",
+        icon="RESTRICT_RENDER_OFF" if settings.show_render else "RESTRICT_RENDER_ON",
+    )
     return row

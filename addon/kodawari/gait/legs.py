@@ -1,6 +1,6 @@
 """Finding a quadruped's four legs and the bone that carries its root motion, by bone
 names (every common naming convention) or from four selected foot bones. Set-up time
-only: reads the armature's rest data, changes nothing."""
+only: reads the armature's rest data, changes nothing (docs/algorithms.md §4.11)."""
 
 import re
 

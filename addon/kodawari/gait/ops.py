@@ -18,20 +18,18 @@ def _armature(context):
 
 
 class KODAWARI_OT_gait_setup(bpy.types.Operator):
-    """Find the four legs (by name, or from four selected foot bones) and the bone that
-    carries root motion; fill the gait settings with the horse's gait table scaled to
-    this animal and joint ranges from the rig's rest pose"""
+    """Find the four legs (by name, or from four selected feet) and the bone that carries the animal; fill in a horse's gaits scaled to this animal and joint ranges from its rest pose"""
 
     bl_idname = "kodawari.gait_setup"
     bl_label = "Gait Setup"
     bl_options = {"REGISTER", "UNDO"}
 
     limits: bpy.props.EnumProperty(
-        name="Joint Ranges", default="REST",
+        name="Joint Ranges", default="REST", description="How far each leg joint may bend",
         items=(("REST", "From Rest Pose", "Each joint bends the way it bends at rest, within a range around it"),
-               ("HORSE", "Horse", "The seed's horse ranges for 4-bone legs (others from the rest pose)")))
+               ("HORSE", "Horse", "A horse's joint ranges for 4-bone legs (other legs: from the rest pose)")))
     root_motion: bpy.props.EnumProperty(
-        name="Root Motion", default="AUTO",
+        name="Root Motion", default="AUTO", description="Where the bake keys the animal's travel",
         items=(("AUTO", "Automatic", "The body bone when the legs share one, else the armature object"),
                ("BONE", "Body Bone", "The topmost bone carrying the legs whose location Blender applies"),
                ("OBJECT", "Armature Object", "The armature object itself")))

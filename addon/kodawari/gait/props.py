@@ -60,7 +60,7 @@ class KodawariGaitEntry(bpy.types.PropertyGroup):
     froude_max: bpy.props.FloatProperty(name="Top Froude", description="Auto by Froude number: the fastest speed, "
                                         "relative to leg length, at which this gait is chosen", default=0.35, min=0.0)
     use_in_auto: bpy.props.BoolProperty(name="In Auto", description="Auto may choose this gait", default=True)
-    duty_factor_top: bpy.props.FloatProperty(name="Duty Factor at Top", description="Share of a stride each foot is "
+    duty_factor_top: bpy.props.FloatProperty(name="Duty at Top", description="Share of a stride each foot is "
                                              "on the ground at the top of the gait's speed band (gallops: the stance "
                                              "shortens with speed)", subtype="FACTOR", default=0.5, min=0.05, max=0.95)
 

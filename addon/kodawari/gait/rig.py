@@ -56,7 +56,7 @@ def placement(obj):
 
 def gait_frame(obj):
     """(M, s): the armature's world rotation times its scale (3x3) and that scale. The
-    gait core works in this frame: world metres and world up, armature-space points
+    gait core works in this frame (docs/algorithms.md §4.11): world metres and world up, armature-space points
     p mapped to M p (the placement's translation left out). Raises ValueError for a
     non-uniform or mirroring scale, which no hinge survives."""
     m = mat3(placement(obj))
@@ -119,8 +119,8 @@ def forward_of(obj, legs):
 
 
 def rest_limits(rest, lengths):
-    """Pose-relative hinge ranges (degrees) from a leg's rest pose (docs/algorithms.md,
-    "Joint limits from the rest pose"). `rest`: each bone's rest angle relative to its
+    """Pose-relative hinge ranges (degrees) from a leg's rest pose (docs/algorithms.md
+    §4.9). `rest`: each bone's rest angle relative to its
     parent (the first: to straight down); `lengths`: bone lengths in the leg's plane.
 
     The first bone swings +-45 deg about its rest (+-25 when it is a girdle bone above a

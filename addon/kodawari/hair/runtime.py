@@ -31,6 +31,8 @@ CONDITION_CODES = {"VIEW": 0, "POSE": 1, "SPEED": 2}
 # must simulate them in order, not jump again).
 _replaying = False
 DEFAULT_CACHE_MEGABYTES = 256
+# Replays of at least this many frames show their progress on the mouse cursor.
+REPLAY_PROGRESS_FRAMES = 24
 
 
 def cache_budget_bytes():
@@ -173,25 +175,8 @@ class ArmatureRuntime:
             pose_bones.foreach_get("matrix", self.matrices.reshape(-1))
             return
         for i in self.matrix_bones:
-            m = pose_bones[i].matrix  # row-major; the solver takes foreach_get's column-major rows
-            self.matrices[i] = (
-                m[0][0],
-                m[1][0],
-                m[2][0],
-                m[3][0],
-                m[0][1],
-                m[1][1],
-                m[2][1],
-                m[3][1],
-                m[0][2],
-                m[1][2],
-                m[2][2],
-                m[3][2],
-                m[0][3],
-                m[1][3],
-                m[2][3],
-                m[3][3],
-            )
+            # Matrix rows are row-major; the solver takes foreach_get's column-major rows.
+            self.matrices[i] = np.array(pose_bones[i].matrix, np.float32).T.reshape(-1)
 
     def _read_other_rotations(self, pose_bones):
         """The current rotations of the bones the solver does not write (foreach_set writes all)."""
@@ -299,13 +284,23 @@ def _can_replay(depsgraph):
 
 
 def _replay(scene, first, last):
+    """Plays first..last in order; a long replay shows its progress on the cursor."""
+    import bpy
+
     global _replaying
     _replaying = True
+    wm = bpy.context.window_manager if last - first >= REPLAY_PROGRESS_FRAMES else None
+    if wm is not None:
+        wm.progress_begin(first, last)
     try:
         for frame in range(first, last + 1):
             scene.frame_set(frame)  # frame_change_post simulates it (previous frame cached)
+            if wm is not None:
+                wm.progress_update(frame)
     finally:
         _replaying = False
+        if wm is not None:
+            wm.progress_end()
 
 
 def get(obj, build=True):

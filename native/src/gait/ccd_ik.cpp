@@ -148,7 +148,8 @@ CcdResult solve_ccd(const LegChain& chain, const Vec2& target, int iterations, R
   return result;
 }
 
-CcdResult solve_dls(const LegChain& chain, const Vec2& target, int iterations, Real tolerance, Real* angles) {
+CcdResult solve_dls(const LegChain& chain, const Vec2& target, int iterations, Real tolerance, Real* angles,
+                    bool soften) {
   const int n = chain.size();
   for (int k = 0; k < n; ++k) {
     angles[k] = std::isfinite(angles[k]) ? std::clamp(angles[k], chain.limit_min[k], chain.limit_max[k])
@@ -194,7 +195,7 @@ CcdResult solve_dls(const LegChain& chain, const Vec2& target, int iterations, R
         const bool at_max = angles[k] >= chain.limit_max[k] - 1e-9 && step[k] > 0;
         if (!held[k] && (at_min || at_max)) changed = held[k] = true;
       }
-      if (pass == 0) {  // soften the joints turning into a limit, from the first step's direction
+      if (pass == 0 && soften) {  // soften the joints turning into a limit, from the first step's direction
         for (int k = 0; k < n; ++k) {
           const Real room = step[k] > 0 ? chain.limit_max[k] - angles[k] : angles[k] - chain.limit_min[k];
           const Real margin = std::min(Real(0.35), (chain.limit_max[k] - chain.limit_min[k]) / 4);

@@ -100,6 +100,16 @@ class LegIk {
         return st.last_error;
       }
       if (planted) {
+        // Least change again without slowing near the limits (it stalls when most joints
+        // are near theirs), still continuous.
+        Real hard[kMaxBones];
+        std::copy(dls, dls + n_, hard);
+        const Real hard_error = solve_dls(chain_, goal2, 4 * in_.ccd_iterations, tolerance, hard, false).error;
+        if (hard_error <= kStanceTolerance) {
+          std::copy(hard, hard + n_, angles);
+          st.last_error = hard_error;
+          return st.last_error;
+        }
         // CCD on from there; a cold restart (a new configuration) only if the foot would
         // otherwise slide more than kStanceSlide.
         std::copy(dls, dls + n_, angles);

@@ -1,6 +1,8 @@
 #include "kodawari/rod/inextensibility.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "kodawari/rod/oriented_particles.hpp"
 
@@ -22,6 +24,13 @@ bool project_chain_lengths(Vec3* x, std::size_t count, const Real* lengths, cons
   Real* upper = scratch + m;        // S_k,k+1
   Real* rhs = scratch + 2 * m;      // -C_k, then lambda_k
   Real* normals = scratch + 3 * m;  // n_k (3 per constraint) of the linearisation point
+  Vec3* best = reinterpret_cast<Vec3*>(scratch + 6 * m);  // the positions closest so far
+  Real best_worst = std::numeric_limits<Real>::infinity();
+  auto worst_error = [&] {
+    Real worst = 0;
+    for (std::size_t k = 0; k < m; ++k) worst = std::max(worst, std::abs((x[k + 1] - x[k]).norm() - lengths[k]) / lengths[k]);
+    return worst;
+  };
   for (int step = 0; step < newton_steps; ++step) {
     // S = J M^-1 J^T (tridiagonal) and -C. Segment k joins x[k] (gradient -n_k) and x[k+1]
     // (+n_k); segments k and k+1 share x[k+1]: S_k,k+1 = -w_{k+1} n_k . n_{k+1}.
@@ -36,20 +45,29 @@ bool project_chain_lengths(Vec3* x, std::size_t count, const Real* lengths, cons
       diag[k] = inverse_mass[k] + inverse_mass[k + 1];
       if (k > 0) {
         const Real* previous = normals + 3 * (k - 1);
-        upper[k - 1] = -inverse_mass[k] * (previous[0] * normal.x() + previous[1] * normal.y() + previous[2] * normal.z());
+        const Real cosine = previous[0] * normal.x() + previous[1] * normal.y() + previous[2] * normal.z();
+        upper[k - 1] = -inverse_mass[k] * cosine;
       }
       rhs[k] = lengths[k] - len;
       const Real error = std::abs(rhs[k]) / lengths[k];
       if (error > worst) worst = error;
     }
     if (worst < kConverged) return true;
+    if (worst < best_worst) {
+      best_worst = worst;
+      std::copy(x, x + count, best);
+    }
     if (worst > kFar && sweeps > 0) {
       // Far from the manifold (a fast tip moves bones' lengths per substep on long chains)
       // a linearisation means little: Gauss-Seidel sweeps of the same mass-weighted distance
       // projection (PBD, each an exact local projection) bring the chain close first.
       for (int sweep = 0; sweep < sweeps; ++sweep) {
-        for (std::size_t k = 0; k < m; ++k) project_distance(x[k], x[k + 1], inverse_mass[k], inverse_mass[k + 1], lengths[k]);
-        for (std::size_t k = m; k-- > 0;) project_distance(x[k], x[k + 1], inverse_mass[k], inverse_mass[k + 1], lengths[k]);
+        for (std::size_t k = 0; k < m; ++k) {
+          project_distance(x[k], x[k + 1], inverse_mass[k], inverse_mass[k + 1], lengths[k]);
+        }
+        for (std::size_t k = m; k-- > 0;) {
+          project_distance(x[k], x[k + 1], inverse_mass[k], inverse_mass[k + 1], lengths[k]);
+        }
       }
       sweeps = 0;
       --step;  // the sweeps do not count as a Newton step
@@ -74,6 +92,12 @@ bool project_chain_lengths(Vec3* x, std::size_t count, const Real* lengths, cons
       x[k + 1] += inverse_mass[k + 1] * push;
     }
   }
+  // Not converged in newton_steps: far from the manifold on a long, bent chain the
+  // linearisation can mislead (its corrections add up along the chain). Keep the closest
+  // positions seen; the caller closes what is left joint by joint.
+  const Real worst = worst_error();
+  if (worst < kConverged) return true;
+  if (worst > best_worst) std::copy(best, best + count, x);
   return false;
 }
 

@@ -82,7 +82,7 @@ void RodSystem::simulate(std::size_t r, const FrameInput& input, const std::vect
   w.lengths.resize(n);
   w.inverse_mass.assign(n + 1, Real(1));
   w.inverse_mass[0] = 0;  // the root joint is kinematic
-  w.projection.resize(6 * (n + 1));
+  w.projection.resize(9 * (n + 1));
   for (std::size_t k = 0; k < n; ++k) w.lengths[k] = rod.geometry.segment_length(k);
   const Real ellipsoid = [&] {
     Real mean = 0;
@@ -155,133 +155,133 @@ void RodSystem::simulate(std::size_t r, const FrameInput& input, const std::vect
     const Real decay = std::exp(-p.damping * dt);
     const Real stiffness = split == 1 ? p.stiffness : Real(1) - std::pow(Real(1) - p.stiffness, Real(1) / Real(split));
     for (int sub = 1; sub <= split; ++sub) {
-    const Real f = (Real(step - 1) + Real(sub) / Real(split)) / Real(steps);
-    const Vec3 anchor = anchor_start + f * (anchor_end - anchor_start);
-    const Quat anchor_rotation = anchor_start_rotation.slerp(f, anchor_end_rotation).normalized();
-    x[0] = anchor + anchor_rotation * x_rest[0];
-    q[0] = anchor_rotation;
-    x[1] = anchor;
+      const Real f = (Real(step - 1) + Real(sub) / Real(split)) / Real(steps);
+      const Vec3 anchor = anchor_start + f * (anchor_end - anchor_start);
+      const Quat anchor_rotation = anchor_start_rotation.slerp(f, anchor_end_rotation).normalized();
+      x[0] = anchor + anchor_rotation * x_rest[0];
+      q[0] = anchor_rotation;
+      x[1] = anchor;
 
-    // Wind with gusts: GLM Perlin noise over time, one noise line per rod (deterministic).
-    const bool windy = p.wind.squaredNorm() > 0;
-    Vec3 wind = Vec3::Zero();
-    if (windy) {
-      const Real t = input.time - (1 - f) * input.frame_dt;
-      const Real gust = 1 + kGustAmount * Real(glm::perlin(glm::dvec2(t * kGustFrequency, 0.37 * Real(r) + 0.5)));
-      wind = world_to_armature * (p.wind * gust);
-    }
-
-    // Predict.
-    for (std::size_t j = 2; j < count; ++j) {
-      Vec3 a = gravity;
-      if (windy) a += kWindDrag * (wind - s.v[j]);
-      s.v[j] = decay * s.v[j] + dt * a;
-      s.prev_x[j] = x[j];
-      x[j] += dt * s.v[j];
-    }
-    for (std::size_t j = 1; j < count; ++j) {
-      s.omega[j] *= decay;
-      s.prev_q[j] = q[j];
-      q[j] = spin(q[j], s.omega[j] * dt);
-    }
-
-    for (int it = 0; it < p.iterations; ++it) {
-      // Shape matching over each particle's neighbourhood {c-1, c, c+1} (Jacobi: averaged).
-      // E_j = R(q_j) R(q̄_j)ᵀ = R(q_j q̄_j⁻¹); that quaternion also warm-starts group j's fit.
-      for (std::size_t j = 0; j < count; ++j) {
-        w.orientation_quats[j] = q[j] * w.q_rest_conjugate[j];
-        w.orientation_terms[j] = rotation_matrix(w.orientation_quats[j]);
+      // Wind with gusts: GLM Perlin noise over time, one noise line per rod (deterministic).
+      const bool windy = p.wind.squaredNorm() > 0;
+      Vec3 wind = Vec3::Zero();
+      if (windy) {
+        const Real t = input.time - (1 - f) * input.frame_dt;
+        const Real gust = 1 + kGustAmount * Real(glm::perlin(glm::dvec2(t * kGustFrequency, 0.37 * Real(r) + 0.5)));
+        wind = world_to_armature * (p.wind * gust);
       }
-      for (std::size_t j = 0; j < count; ++j) w.displacement[j].setZero();
-      for (std::size_t c = 1; c < count; ++c) {
-        const std::size_t lo = c - 1;
-        const std::size_t members = c + 1 < count ? 3 : 2;
-        const Real* gw = &w.group_weights[3 * c];
-        const Real* ge = &w.group_ellipsoid[3 * c];
-        const Vec3* rest = &w.group_rest[3 * c];
-        const Vec3* weighted_rest = &w.group_weighted_rest[3 * c];
-        // A = Σ w_i (x_i - c)(x̄_i - c̄)ᵀ + e Σ w_i E_i: the ellipsoid term of Müller & Chentanez
-        // 2011 (e = a²/5) with each particle's orientation defines twist even on a chain.
-        const Mat3* E = &w.orientation_terms[lo];
-        Vec3 centroid = gw[0] * x[lo] + gw[1] * x[lo + 1];
-        Mat3 A = x[lo] * weighted_rest[0].transpose() + x[lo + 1] * weighted_rest[1].transpose();
-        Mat3 orientations;
-        if (lo >= 2) {
-          orientations = E[0] + E[1];  // dynamic particles all weigh 1
-        } else {
-          orientations = ge[0] * E[0] + ge[1] * E[1];
+
+      // Predict.
+      for (std::size_t j = 2; j < count; ++j) {
+        Vec3 a = gravity;
+        if (windy) a += kWindDrag * (wind - s.v[j]);
+        s.v[j] = decay * s.v[j] + dt * a;
+        s.prev_x[j] = x[j];
+        x[j] += dt * s.v[j];
+      }
+      for (std::size_t j = 1; j < count; ++j) {
+        s.omega[j] *= decay;
+        s.prev_q[j] = q[j];
+        q[j] = spin(q[j], s.omega[j] * dt);
+      }
+
+      for (int it = 0; it < p.iterations; ++it) {
+        // Shape matching over each particle's neighbourhood {c-1, c, c+1} (Jacobi: averaged).
+        // E_j = R(q_j) R(q̄_j)ᵀ = R(q_j q̄_j⁻¹); that quaternion also warm-starts group j's fit.
+        for (std::size_t j = 0; j < count; ++j) {
+          w.orientation_quats[j] = q[j] * w.q_rest_conjugate[j];
+          w.orientation_terms[j] = rotation_matrix(w.orientation_quats[j]);
         }
-        if (members == 3) {
-          centroid += gw[2] * x[lo + 2];
-          A += x[lo + 2] * weighted_rest[2].transpose();
+        for (std::size_t j = 0; j < count; ++j) w.displacement[j].setZero();
+        for (std::size_t c = 1; c < count; ++c) {
+          const std::size_t lo = c - 1;
+          const std::size_t members = c + 1 < count ? 3 : 2;
+          const Real* gw = &w.group_weights[3 * c];
+          const Real* ge = &w.group_ellipsoid[3 * c];
+          const Vec3* rest = &w.group_rest[3 * c];
+          const Vec3* weighted_rest = &w.group_weighted_rest[3 * c];
+          // A = Σ w_i (x_i - c)(x̄_i - c̄)ᵀ + e Σ w_i E_i: the ellipsoid term of Müller & Chentanez
+          // 2011 (e = a²/5) with each particle's orientation defines twist even on a chain.
+          const Mat3* E = &w.orientation_terms[lo];
+          Vec3 centroid = gw[0] * x[lo] + gw[1] * x[lo + 1];
+          Mat3 A = x[lo] * weighted_rest[0].transpose() + x[lo + 1] * weighted_rest[1].transpose();
+          Mat3 orientations;
           if (lo >= 2) {
-            orientations += E[2];
+            orientations = E[0] + E[1];  // dynamic particles all weigh 1
           } else {
-            orientations += ge[2] * E[2];
+            orientations = ge[0] * E[0] + ge[1] * E[1];
           }
+          if (members == 3) {
+            centroid += gw[2] * x[lo + 2];
+            A += x[lo + 2] * weighted_rest[2].transpose();
+            if (lo >= 2) {
+              orientations += E[2];
+            } else {
+              orientations += ge[2] * E[2];
+            }
+          }
+          A += lo >= 2 ? Mat3(ellipsoid * orientations) : orientations;
+          // Rotational part of A: one warm-started step of Müller et al. 2016 (see extract_rotation),
+          // from the guess q_c q̄_c⁻¹ whose matrix E_c is already at hand.
+          const Mat3& G = w.orientation_terms[c];
+          const Vec3 torque = G.col(0).cross(A.col(0)) + G.col(1).cross(A.col(1)) + G.col(2).cross(A.col(2));
+          const Real denom = std::abs(G.col(0).dot(A.col(0)) + G.col(1).dot(A.col(1)) + G.col(2).dot(A.col(2))) + 1e-12;
+          const Vec3 omega = torque * (Real(0.5) / denom);
+          Quat R = w.orientation_quats[c];
+          Mat3 Rm = G;
+          if (omega.squaredNorm() >= Real(0.25e-24)) {
+            R = unit(Quat(1, omega.x(), omega.y(), omega.z()) * R);
+            Rm = rotation_matrix(R);
+          }
+          for (std::size_t i = 0; i < members; ++i) {
+            const std::size_t j = lo + i;
+            if (j < 2) continue;
+            w.displacement[j] += Rm * rest[i] + centroid - x[j];
+          }
+          w.new_q[c] = R * q_rest[c];
         }
-        A += lo >= 2 ? Mat3(ellipsoid * orientations) : orientations;
-        // Rotational part of A: one warm-started step of Müller et al. 2016 (see extract_rotation),
-        // from the guess q_c q̄_c⁻¹ whose matrix E_c is already at hand.
-        const Mat3& G = w.orientation_terms[c];
-        const Vec3 torque = G.col(0).cross(A.col(0)) + G.col(1).cross(A.col(1)) + G.col(2).cross(A.col(2));
-        const Real denom = std::abs(G.col(0).dot(A.col(0)) + G.col(1).dot(A.col(1)) + G.col(2).dot(A.col(2))) + 1e-12;
-        const Vec3 omega = torque * (Real(0.5) / denom);
-        Quat R = w.orientation_quats[c];
-        Mat3 Rm = G;
-        if (omega.squaredNorm() >= Real(0.25e-24)) {
-          R = unit(Quat(1, omega.x(), omega.y(), omega.z()) * R);
-          Rm = rotation_matrix(R);
+        for (std::size_t j = 2; j < count; ++j) x[j] += (stiffness * w.inverse_hits[j]) * w.displacement[j];
+        for (std::size_t c = 1; c < count; ++c) {
+          const Quat& target = w.new_q[c];
+          // Blend towards the (sign-aligned) target; the normalisation absorbs |target| != 1.
+          const Real sign = target.dot(q[c]) < 0 ? -stiffness : stiffness;
+          q[c] = unit(Quat((1 - stiffness) * q[c].coeffs() + sign * target.coeffs()));
         }
-        for (std::size_t i = 0; i < members; ++i) {
-          const std::size_t j = lo + i;
-          if (j < 2) continue;
-          w.displacement[j] += Rm * rest[i] + centroid - x[j];
+        // Inextensibility: PBD distance constraints, root (kinematic) to tip.
+        project_distance(x[1], x[2], 0, 1, w.lengths[0]);
+        for (std::size_t k = 1; k < n; ++k) project_distance(x[k + 1], x[k + 2], 1, 1, w.lengths[k]);
+        if (!colliders.empty()) {
+          for (std::size_t j = 2; j < count; ++j) push_out_of_colliders(x[j], colliders, p.radius);
         }
-        w.new_q[c] = R * q_rest[c];
       }
-      for (std::size_t j = 2; j < count; ++j) x[j] += (stiffness * w.inverse_hits[j]) * w.displacement[j];
-      for (std::size_t c = 1; c < count; ++c) {
-        const Quat& target = w.new_q[c];
-        // Blend towards the (sign-aligned) target; the normalisation absorbs |target| != 1.
-        const Real sign = target.dot(q[c]) < 0 ? -stiffness : stiffness;
-        q[c] = unit(Quat((1 - stiffness) * q[c].coeffs() + sign * target.coeffs()));
-      }
-      // Inextensibility: PBD distance constraints, root (kinematic) to tip.
-      project_distance(x[1], x[2], 0, 1, w.lengths[0]);
-      for (std::size_t k = 1; k < n; ++k) project_distance(x[k + 1], x[k + 2], 1, 1, w.lengths[k]);
+      // Inextensibility (docs/algorithms.md §3.3 step 3): the mass-weighted
+      // projection onto the bone lengths (both ends of every segment move, momentum is kept;
+      // rod/inextensibility.hpp), then the collider push-out.
+      const bool converged =
+          project_chain_lengths(x + 1, n + 1, w.lengths.data(), w.inverse_mass.data(), w.projection.data());
+      bool pushed = false;
       if (!colliders.empty()) {
-        for (std::size_t j = 2; j < count; ++j) push_out_of_colliders(x[j], colliders, p.radius);
+        for (std::size_t j = 2; j < count; ++j) pushed = push_out_of_colliders(x[j], colliders, p.radius) || pushed;
       }
-    }
-    // Inextensibility (docs/algorithms.md §3.3 step 3): the mass-weighted
-    // projection onto the bone lengths (both ends of every segment move, momentum is kept;
-    // rod/inextensibility.hpp), then the collider push-out.
-    const bool converged =
-        project_chain_lengths(x + 1, n + 1, w.lengths.data(), w.inverse_mass.data(), w.projection.data());
-    bool pushed = false;
-    if (!colliders.empty()) {
-      for (std::size_t j = 2; j < count; ++j) pushed = push_out_of_colliders(x[j], colliders, p.radius) || pushed;
-    }
-    // What the projection left (a contact, a step it did not fully converge in) is closed
-    // joint by joint from the root, each onto its bone length and out of the colliders, so
-    // lengths hold exactly on output. Alone, as the length pass this once was, this one-sided
-    // "follow the leader" correction passed every correction down to the tip as velocity and
-    // pumped energy into chains of ten or more bones (issue 9); here it moves joints by
-    // round-off, or only in contact, where the push-out dissipates anyway.
-    for (std::size_t k = 0; k < n && (pushed || !converged); ++k) {
-      Vec3& a = x[k + 1];
-      Vec3& b = x[k + 2];
-      for (int pass = 0; pass < 4; ++pass) {
-        const Vec3 d = b - a;
-        const Real len = d.norm();
-        b = len > 1e-12 ? Vec3(a + d * (w.lengths[k] / len))
-                        : Vec3(a + q[k + 1] * (w.lengths[k] * rod.geometry.segment_axis(k)));
-        if (colliders.empty() || !push_out_of_colliders(b, colliders, p.radius)) break;
+      // What the projection left (a contact, a step it did not fully converge in) is closed
+      // joint by joint from the root, each onto its bone length and out of the colliders, so
+      // lengths hold exactly on output. Alone, as the length pass this once was, this one-sided
+      // "follow the leader" correction passed every correction down to the tip as velocity and
+      // pumped energy into chains of ten or more bones (§3.3); here it moves joints by
+      // round-off, or only in contact, where the push-out dissipates anyway.
+      for (std::size_t k = 0; k < n && (pushed || !converged); ++k) {
+        Vec3& a = x[k + 1];
+        Vec3& b = x[k + 2];
+        for (int pass = 0; pass < 4; ++pass) {
+          const Vec3 d = b - a;
+          const Real len = d.norm();
+          b = len > 1e-12 ? Vec3(a + d * (w.lengths[k] / len))
+                          : Vec3(a + q[k + 1] * (w.lengths[k] * rod.geometry.segment_axis(k)));
+          if (colliders.empty() || !push_out_of_colliders(b, colliders, p.radius)) break;
+        }
       }
-    }
-    for (std::size_t j = 2; j < count; ++j) s.v[j] = (x[j] - s.prev_x[j]) * inverse_dt;
-    for (std::size_t j = 1; j < count; ++j) s.omega[j] = angular_velocity(s.prev_q[j], q[j], dt);
+      for (std::size_t j = 2; j < count; ++j) s.v[j] = (x[j] - s.prev_x[j]) * inverse_dt;
+      for (std::size_t j = 1; j < count; ++j) s.omega[j] = angular_velocity(s.prev_q[j], q[j], dt);
     }
   }
   s.anchor_position = anchor_end;

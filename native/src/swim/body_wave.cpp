@@ -1,5 +1,7 @@
 #include "kodawari/swim/body_wave.hpp"
 
+#include <Eigen/Dense>
+
 #include <algorithm>
 #include <cmath>
 
@@ -31,12 +33,76 @@ std::vector<Real> arc_fractions(const Vec3List& points) {
   return s;
 }
 
+namespace {
+
+constexpr int kFitSamples = 96;  // curve samples the control offsets are fitted to
+
+// Arc-length fraction of the rest curve at parameters t (dense samples, interpolated).
+std::vector<Real> arc_fraction_at(const ffd::CubicBSpline& curve, const std::vector<Real>& t) {
+  constexpr int kSamples = 256;
+  std::vector<Real> arc(kSamples + 1, Real(0));
+  Vec3 previous = curve.point(0);
+  for (int k = 1; k <= kSamples; ++k) {
+    const Vec3 here = curve.point(Real(k) / kSamples);
+    arc[k] = arc[k - 1] + (here - previous).norm();
+    previous = here;
+  }
+  std::vector<Real> out(t.size());
+  for (std::size_t j = 0; j < t.size(); ++j) {
+    const Real x = std::clamp(t[j], Real(0), Real(1)) * kSamples;
+    const int k = std::clamp(static_cast<int>(x), 0, kSamples - 1);
+    const Real a = arc[k] + (x - k) * (arc[k + 1] - arc[k]);
+    out[j] = arc.back() > 0 ? a / arc.back() : t[j];
+  }
+  return out;
+}
+
+}  // namespace
+
+std::vector<Real> fitted_offsets(const Vec3List& rest, Real body_length, const BodyWave& wave, Real phase) {
+  const int n = static_cast<int>(rest.size());
+  if (n < 4) {
+    const std::vector<Real> s = arc_fractions(rest);
+    std::vector<Real> out(s.size());
+    for (std::size_t i = 0; i < s.size(); ++i) out[i] = body_length * wave_offset(wave, s[i], phase);
+    return out;
+  }
+  std::vector<Real> t(kFitSamples);
+  for (int j = 0; j < kFitSamples; ++j) t[j] = Real(j) / (kFitSamples - 1);
+  const std::vector<Real> s = arc_fraction_at(ffd::CubicBSpline(rest), t);
+  Eigen::MatrixXd basis = Eigen::MatrixXd::Zero(kFitSamples, n);
+  Eigen::VectorXd values(kFitSamples);
+  for (int j = 0; j < kFitSamples; ++j) {
+    const ffd::CubicBasis b = ffd::cubic_basis(n, t[j]);
+    for (int k = 0; k < 4; ++k) {
+      if (b.first + k < n) basis(j, b.first + k) += b.value[k];
+    }
+    values[j] = body_length * wave_offset(wave, s[j], phase);
+  }
+  // The clamped curve starts exactly at its first point: it takes the wave there (a
+  // pinned snout stays pinned); the others are fitted by least squares so the B-spline
+  // curve (not its control polygon) follows the wave, the tail tip held closely.
+  std::vector<Real> out(static_cast<std::size_t>(n));
+  out.front() = values[0];
+  Eigen::VectorXd rhs = values - basis.col(0) * out.front();
+  Eigen::MatrixXd fit = basis.rightCols(n - 1);
+  // The tail tip counts twice: its amplitude is the setting (within ~1%).
+  constexpr Real kTipWeight = 2;
+  fit.row(kFitSamples - 1) *= kTipWeight;
+  rhs[kFitSamples - 1] *= kTipWeight;
+  const Eigen::VectorXd rest_points = fit.colPivHouseholderQr().solve(rhs);
+  for (int i = 1; i < n; ++i) out[static_cast<std::size_t>(i)] = rest_points[i - 1];
+  return out;
+}
+
 Vec3List body_axis(const Vec3List& rest, const Vec3& bend_direction, Real body_length, const BodyWave& wave,
                    Real phase) {
   const std::size_t n = rest.size();
-  const std::vector<Real> s = arc_fractions(rest);
-  std::vector<Real> wanted(n);
-  for (std::size_t i = 0; i < n; ++i) wanted[i] = body_length * wave_offset(wave, s[i], phase);
+  // The control offsets are fitted (least squares over the whole curve) so the B-SPLINE
+  // CURVE follows the wave. Offsetting the control points by the wave itself lets the
+  // approximating spline blur the phase where the envelope grows fast: the wave came out
+  // up to 47% long (thunniform, 8 points; docs/algorithms.md §2.1).
+  const std::vector<Real> wanted = fitted_offsets(rest, body_length, wave, phase);
 
   Vec3List targets(n);
   for (std::size_t i = 0; i < n; ++i) targets[i] = rest[i] + wanted[i] * bend_direction;

@@ -54,7 +54,10 @@ CcdResult solve_ccd(const LegChain& chain, const Vec2& target, int iterations, R
 // step is the least weighted change that moves the foot towards the target, so the
 // pose follows a moving target continuously: it never jumps to another leg
 // configuration the way a CCD sweep can. A joint that reaches a limit is held there.
-CcdResult solve_dls(const LegChain& chain, const Vec2& target, int iterations, Real tolerance, Real* angles);
+// `soften` false: no slowing near the limits (a second try where the softened solve
+// stalls with most joints near their limits).
+CcdResult solve_dls(const LegChain& chain, const Vec2& target, int iterations, Real tolerance, Real* angles,
+                    bool soften = true);
 
 // How far the chain reaches from its root along `direction` (unit, (f, u)) within its
 // limits: the foot's distance along the direction after solving towards a far target.

@@ -49,7 +49,7 @@ constexpr const char* kLegNames[kLegCount] = {"LF", "RF", "LH", "RH"};
 constexpr Real kHorseLegLength = 1.406;
 
 // The table for an animal whose hip stands `leg_length` m high, by dynamic similarity
-// (Alexander & Jayes 1983; docs/algorithms.md §4.2): at equal Froude number
+// (Alexander & Jayes 1983; docs/algorithms.md §4.12): at equal Froude number
 // v^2/(g L) animals use the same duty factors and phases, strides scale with L, so
 // speeds scale with sqrt(L / L0), times with sqrt(L / L0), heights with L / L0.
 // Froude band tops are dimensionless and stay.

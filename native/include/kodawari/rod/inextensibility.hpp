@@ -20,7 +20,7 @@ namespace kodawari::rod {
 
 // Projects x[0..count) onto the chain's lengths (lengths[k] between x[k] and x[k + 1]).
 // inverse_mass[k] = 0 marks a kinematic particle (the root). `scratch` holds at least
-// 6 * count values. True when every length is within 1e-5 (relative) on return.
+// 9 * count values (aligned for Vec3). True when every length is within 1e-5 (relative) on return.
 bool project_chain_lengths(Vec3* x, std::size_t count, const Real* lengths, const Real* inverse_mass,
                            Real* scratch, int newton_steps = 6, int sweeps = 1);
 

@@ -31,6 +31,11 @@ Real wave_offset(const BodyWave& wave, Real s, Real phase);
 // Fractions of the rest polygon's arc length at each control point (0 at the head, 1 at the tail).
 std::vector<Real> arc_fractions(const Vec3List& points);
 
+// Control-point offsets (length units, along the bend direction) whose clamped cubic
+// B-spline follows the wave y(s, φ) of the rest curve's arc fraction s: a least-squares
+// fit over 96 curve samples (fewer than 4 points: the wave at the points themselves).
+std::vector<Real> fitted_offsets(const Vec3List& rest, Real body_length, const BodyWave& wave, Real phase);
+
 // Control points of the swimming body axis for one phase. `bend_direction` is the
 // unit direction the wave displaces points in (lateral or dorsoventral);
 // `body_length` scales the amplitudes. With preserve_length the displacement along

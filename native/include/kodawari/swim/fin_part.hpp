@@ -1,0 +1,59 @@
+// One fin part bound for motion (docs/algorithms.md §2.4). Replaces a
+// per-fin FFD: every fin vertex swings as if hinged at its OWN root point (the
+// lever is its reach across the fin, along the fin's outward direction),
+// with the motion's angle faded in by a weight that rises from 0 on the body to 1
+// out on the fin. Neighbouring vertices then get nearly the same rotation, so the
+// fade can shear the mesh only by about 0.9·angle (~1.1x edge stretch at 0.6 rad)
+// and a long-based fin (dorsal, anal) never swings its base ends away from the body.
+// An undulation may not tilt the fin past 45°; a TWIST is held to max_roll (the fade
+// shears under 0.5); feathering is not held (a blade must turn edge-on).
+#pragma once
+
+#include <cstddef>
+#include <vector>
+
+#include "kodawari/common.hpp"
+#include "kodawari/swim/fin_motion.hpp"
+
+namespace kodawari::swim {
+
+struct FinPartRest {
+  Vec3 root{0, 0, 0};        // where the part meets the body (centroid of its root row)
+  Vec3 outward{1, 0, 0};     // unit, root → tip
+  RootFrame frame;           // the body's tailward tangent, side and up at the root
+  Real height = 1;           // reach range root → rim (length units)
+  Real base_length = 1;      // along the body (UNDULATE's wave runs along it)
+  Real base_front = 0;       // tangent coordinate of the base's front end
+};
+
+class FinPartBinding {
+ public:
+  // points: M rest positions; reach: M path lengths across the fin from the body
+  // (0 at the root); weight: M fade weights in [0, 1] (group weight × root fade);
+  // weight_slope: the largest d(weight)/d(reach), for the caps.
+  FinPartBinding(const Vec3List& points, const std::vector<Real>& reach, const std::vector<Real>& weight,
+                 const FinPartRest& rest);
+
+  std::size_t count() const { return reach_.size(); }
+
+  // Writes M displacements (xyz floats) of the part for a phase, turned by
+  // `body_rotation` (the body's rotation at the root, rest → now).
+  void displace(const FinWave& wave, Real phase, const Mat3& body_rotation, float* out) const;
+
+  // The largest roll (twist / feathering) and undulation amplitude (length units)
+  // the fade allows without shearing the mesh by more than 0.5.
+  Real max_roll() const { return max_roll_; }
+  Real max_undulation() const { return max_undulation_; }
+
+ private:
+  Vec3List across_;            // offset from the part's centre line, perpendicular to `outward`
+  std::vector<Real> reach_, weight_, along_, height_;
+  FinPartRest rest_;
+  Real max_roll_ = 0, max_undulation_ = 0;
+};
+
+// Nearest rotation to the map taking the rest probe arms to the current ones
+// (polar decomposition): rest/now hold 4 points each, a root and its three arms.
+Mat3 probe_rotation(const Vec3List& rest, const Vec3List& now);
+
+}  // namespace kodawari::swim

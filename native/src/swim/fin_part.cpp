@@ -1,0 +1,129 @@
+#include "kodawari/swim/fin_part.hpp"
+
+#include <Eigen/Dense>
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include "kodawari/parallel.hpp"
+
+namespace kodawari::swim {
+
+namespace {
+
+constexpr Real kMaxShear = 0.5;
+
+Vec3 unit_cross_or(const Vec3& a, const Vec3& b, const Vec3& fallback) {
+  const Vec3 c = a.cross(b);
+  const Real norm = c.norm();
+  return norm > Real(0.3) ? Vec3(c / norm) : fallback.normalized();
+}
+
+}  // namespace
+
+FinPartBinding::FinPartBinding(const Vec3List& points, const std::vector<Real>& reach,
+                               const std::vector<Real>& weight, const FinPartRest& rest)
+    : reach_(reach), weight_(weight), rest_(rest) {
+  const std::size_t m = points.size();
+  if (reach.size() != m || weight.size() != m) throw std::invalid_argument("reach and weight need one value per point");
+  if (!(rest_.outward.norm() > 0)) throw std::invalid_argument("the fin's outward direction is zero");
+  rest_.outward.normalize();
+  across_.resize(m);
+  height_.resize(m);
+  along_.resize(m);
+  const Real base = std::max(rest_.base_length, Real(1e-9));
+  // The fade's steepest slope: d(weight)/d(reach) between vertices sorted by reach.
+  std::vector<std::size_t> order(m);
+  for (std::size_t i = 0; i < m; ++i) order[i] = i;
+  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return reach[a] < reach[b]; });
+  Real roll_lever = 0, slope = 0;
+  for (std::size_t i = 0; i < m; ++i) {
+    const Vec3 d = points[i] - rest_.root;
+    height_[i] = d.dot(rest_.outward);
+    across_[i] = d - height_[i] * rest_.outward;
+    along_[i] = (points[i].dot(rest_.frame.tangent) - rest_.base_front) / base;
+  }
+  // Slope over a window of neighbours in reach (robust to duplicate reaches).
+  const std::size_t window = std::max<std::size_t>(1, m / 50);
+  for (std::size_t k = 0; k + window < m; ++k) {
+    const std::size_t a = order[k], b = order[k + window];
+    const Real dr = reach[b] - reach[a];
+    if (dr <= 0) continue;
+    const Real g = std::abs(weight[b] - weight[a]) / dr;
+    slope = std::max(slope, g);
+    roll_lever = std::max(roll_lever, g * std::max(across_[a].norm(), across_[b].norm()));
+  }
+  max_roll_ = roll_lever > 0 ? kMaxShear / roll_lever : kPi;
+  max_undulation_ = slope > 0 ? kMaxShear / slope : rest_.height;
+}
+
+void FinPartBinding::displace(const FinWave& wave, Real phase, const Mat3& body_rotation, float* out) const {
+  const Vec3& outward = rest_.outward;
+  const RootFrame& f = rest_.frame;
+  Vec3 hinge_axis = Vec3::Zero();
+  Real angle = 0, roll = 0, undulation = 0;
+  switch (wave.motion) {
+    case FinMotion::Flap: {
+      hinge_axis = unit_cross_or(outward, f.tangent, f.up);
+      angle = wave.amplitude * std::sin(phase);
+      const Real toward = wave.feather_on_power ? Real(1) + std::cos(phase) : Real(1) - std::cos(phase);
+      roll = wave.feathering * Real(0.5) * toward;
+      break;
+    }
+    case FinMotion::UpDown:
+      hinge_axis = std::abs(outward.dot(f.tangent)) > Real(0.95) ? f.side.normalized() : f.tangent.normalized();
+      angle = wave.amplitude * std::sin(phase);
+      break;
+    case FinMotion::Twist:
+      // A twist of a long-based fin swings its ends; held where the fade would shear past 0.5.
+      roll = std::clamp(wave.amplitude * std::sin(phase), -max_roll_, max_roll_);
+      break;
+    case FinMotion::Undulate: {
+      // Amplitude is a fraction of the fin's height; the wave may not tilt the fin's
+      // surface past 45° (slope 1), which would fold it.
+      const Real k = Real(2) * kPi / (std::max(wave.wavelength, Real(1e-6)) * std::max(rest_.base_length, Real(1e-9)));
+      undulation = std::min(wave.amplitude * rest_.height, Real(1) / k);
+      break;
+    }
+  }
+  const Real k_wave = Real(2) * kPi / std::max(wave.wavelength, Real(1e-6));
+  parallel_for(reach_.size(), 0, 8192, [&](std::size_t begin, std::size_t end) {
+  for (std::size_t i = begin; i < end; ++i) {
+    const Real w = weight_[i];
+    Vec3 d = Vec3::Zero();
+    if (w > 0) {
+      if (wave.motion == FinMotion::Undulate) {
+        d = w * undulation * std::sin(phase - k_wave * along_[i]) * f.side;
+      } else {
+        // Swing about the vertex's own root point: the lever is its reach across the fin.
+        const Mat3 swing = angle != 0 ? axis_rotation(hinge_axis, w * angle) : Mat3::Identity();
+        const Mat3 twist = roll != 0 ? axis_rotation(outward, w * roll) : Mat3::Identity();
+        d = (swing - Mat3::Identity()) * (reach_[i] * outward) + swing * (twist - Mat3::Identity()) * across_[i];
+      }
+      d = body_rotation * d;
+    }
+    for (int c = 0; c < 3; ++c) out[3 * i + c] = static_cast<float>(d[c]);
+  }
+  });
+}
+
+Mat3 probe_rotation(const Vec3List& rest, const Vec3List& now) {
+  if (rest.size() != 4 || now.size() != 4) throw std::invalid_argument("probe_rotation needs 4 points each");
+  Mat3 before, moved;
+  for (int c = 0; c < 3; ++c) {
+    before.col(c) = rest[c + 1] - rest[0];
+    moved.col(c) = now[c + 1] - now[0];
+  }
+  const Mat3 map = moved * before.inverse();
+  Eigen::JacobiSVD<Mat3> svd(map, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Mat3 u = svd.matrixU();
+  Mat3 r = u * svd.matrixV().transpose();
+  if (r.determinant() < 0) {
+    u.col(2) *= -1;
+    r = u * svd.matrixV().transpose();
+  }
+  return r;
+}
+
+}  // namespace kodawari::swim
