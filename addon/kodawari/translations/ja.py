@@ -421,7 +421,6 @@ STRINGS = {
     "Find the four legs (by name, or from four selected feet) and the bone that carries the animal; fill in a horse's gaits scaled to this animal and joint ranges from its rest pose": "4本の脚（名前から、または選択した4つの足から）と動物を運ぶボーンを見つけ、この動物に合わせた馬の歩容とレストポーズからの関節可動域を設定します",
     "Joint Ranges": "関節可動域",
     "How far each leg joint may bend": "脚の各関節がどこまで曲がれるか",
-    "Where each joint's bending range comes from": "各関節の曲げ範囲の決め方",
     "From Rest Pose": "レストポーズから",
     "Each joint bends the way it bends at rest, within a range around it": "各関節はレストでの曲がり方を中心にその範囲内で曲がります",
     "Horse": "馬",
@@ -440,5 +439,4 @@ STRINGS = {
     "Faster with a faster tail beat, as measured on real fish (Bainbridge 1958: V = L(3f - 4)/4, fitted above about 5 Hz; where it leaves Strouhal 0.2-0.4, the Strouhal speed). Fin swimmers: half a body length per fin beat": "尾の振りが速いほど速く進む（実際の魚の測定、Bainbridge 1958：V = L(3f - 4)/4、約5 Hz 以上で当てはめ。ストローハル数 0.2〜0.4 を外れる所ではストローハルの速度）。ひれで泳ぐ魚：ひれの1振りで体長の半分",
     "Faster with a wider, faster tail swing (Strouhal number). Fin swimmers (no body wave): half a body length per fin beat": "尾の振れが広く速いほど速く進む（ストローハル数）。ひれで泳ぐ魚（体の波なし）：ひれの1振りで体長の半分",
     "Find fins from the geometry (parts standing out of the body's cross-section), make vertex groups and add them": "形状からひれ（体の断面から突き出た部分）を見つけ、頂点グループを作って追加します",
-    "How far each leg joint may bend": "脚の各関節が曲がれる範囲",
 }
