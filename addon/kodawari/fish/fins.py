@@ -149,8 +149,8 @@ def build_parts(fin_index, fin, group_weights, verts, body_axis, up, kn, reach_a
         base = (float(along.min()), float(along.max()))
         if fin.motion == "UNDULATE" and base[1] - base[0] < 1e-6:
             raise ValueError(f"vertex group '{fin.vertex_group}' has no length along the body")
-        # The motion fades in over the first root_blend of the fin (SEEDS §1: the root
-        # must not move, or the fin tears from the body).
+        # The motion fades in over the first root_blend of the fin (docs/algorithms.md
+        # §2.5: the root must not move, or the fin tears from the body).
         # An undulation's sideways wave fades in over the whole fin height: over a short
         # root band it would shear the fin's base (its amplitude is a share of the height).
         # The fade is a smoothstep over a share of the fin's own height (not a fixed
