@@ -290,16 +290,17 @@ void bind_swim(py::module_& m) {
       "(reach float64 (N,), source int64 (N,)): for fin vertices, the path length across the fin from where it "
       "meets the body (0 elsewhere), and the vertex at the root that path starts from.");
   py::class_<swim::FinPartBinding, std::shared_ptr<swim::FinPartBinding>>(
-      m, "FinPart", "One fin part bound for motion: every vertex swings about its own root point, faded in by weight.")
+      m, "FinPart", "One fin part bound for motion: every vertex swings about its own root point, faded in by weight "
+      "(fade > 0: weight × smoothstep(reach / fade), the swing bent along the fin so no line stretches).")
       .def(py::init([](const py::handle& points, const py::handle& reach, const py::handle& weight,
                        const py::handle& root, const py::handle& outward, const py::handle& tangent,
                        const py::handle& side, const py::handle& up, double height, double base_length,
-                       double base_front) {
+                       double base_front, double fade) {
              auto p = checked_array<float>(points, "points", -1, 3);
              const py::ssize_t m = p.shape(0);
              auto r = checked_array<double>(reach, "reach", m, 0);
              auto w = checked_array<double>(weight, "weight", m, 0);
-             for (auto [v, n] : {std::pair{height, "height"}, {base_length, "base_length"}, {base_front, "base_front"}}) {
+             for (auto [v, n] : {std::pair{height, "height"}, {base_length, "base_length"}, {base_front, "base_front"}, {fade, "fade"}}) {
                require_finite(v, n);
              }
              Vec3List pts(static_cast<std::size_t>(m));
@@ -313,11 +314,12 @@ void bind_swim(py::module_& m) {
              rest.base_length = base_length;
              rest.base_front = base_front;
              return std::make_shared<swim::FinPartBinding>(
-                 pts, std::vector<Real>(r.data(), r.data() + m), std::vector<Real>(w.data(), w.data() + m), rest);
+                 pts, std::vector<Real>(r.data(), r.data() + m), std::vector<Real>(w.data(), w.data() + m), rest,
+                 fade);
            }),
            py::arg("points"), py::arg("reach"), py::arg("weight"), py::arg("root"), py::arg("outward"),
            py::arg("tangent"), py::arg("side"), py::arg("up"), py::arg("height"), py::arg("base_length"),
-           py::arg("base_front"))
+           py::arg("base_front"), py::arg("fade") = 0.0)
       .def_property_readonly("count", &swim::FinPartBinding::count)
       .def_property_readonly("max_roll", &swim::FinPartBinding::max_roll)
       .def_property_readonly("max_undulation", &swim::FinPartBinding::max_undulation)
