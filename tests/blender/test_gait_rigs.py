@@ -137,7 +137,8 @@ def test_planted_joints_never_snap(empty_scene, case, fps):
     issue's 10 deg between frames (the first solver: 55 deg on the sample horse; before
     stances were relaxed, 23 deg on one hoof joint of the Rigify horse; now 9 deg at
     most), and at 60 fps none more than 3x its neighbouring frames' change (+1 deg)
-    inside a stance."""
+    inside a stance (touch-down, where the planned foot stops dead, is left out: up to
+    5x there)."""
     from kodawari.gait import runtime
 
     empty_scene.render.fps, empty_scene.render.fps_base = fps, 1.0
@@ -166,7 +167,7 @@ def test_planted_joints_never_snap(empty_scene, case, fps):
         if fps >= 240:
             assert step <= 10.0, (case, leg, step)
         else:
-            assert ratio <= 1.05, (case, leg, ratio)
+            assert ratio <= 1.0, (case, leg, ratio)  # measured 0.35
 
 
 def test_root_motion_defaults_to_the_object_when_the_legs_share_no_bone(empty_scene):
