@@ -133,11 +133,12 @@ def test_walk_gallop_walk_on_the_rig(empty_scene, case):
 
 @pytest.mark.parametrize("case,fps", [("horse", 240), ("sample_horse", 240), ("mixamo@0.01", 60)])
 def test_planted_joints_never_snap(empty_scene, case, fps):
-    """A planted leg keeps its configuration: at 240 fps no joint turns more than 25 deg
-    between frames (the old solver: 55 deg on the sample horse; now 11 deg there and
-    23 deg on one hoof joint of the Rigify horse: the issue's 10 deg is not met yet),
-    and at 60 fps none more than 3x its neighbouring frames' change (+1 deg) inside a
-    stance."""
+    """A planted leg keeps its configuration: at 240 fps no joint turns more than the
+    issue's 10 deg between frames (the first solver: 55 deg on the sample horse; before
+    stances were relaxed, 23 deg on one hoof joint of the Rigify horse; now 9 deg at
+    most), and at 60 fps none more than 3x its neighbouring frames' change (+1 deg)
+    inside a stance (touch-down, where the planned foot stops dead, is left out: up to
+    5x there)."""
     from kodawari.gait import runtime
 
     empty_scene.render.fps, empty_scene.render.fps_base = fps, 1.0
@@ -164,9 +165,9 @@ def test_planted_joints_never_snap(empty_scene, case, fps):
         planted = result["contacts"][:, k] > 0.5
         step, ratio = planted_snaps(joint_angles(legs[leg], heading), planted, min_stance=1 if fps >= 240 else 4)
         if fps >= 240:
-            assert step <= 25.0, (case, leg, step)
+            assert step <= 10.0, (case, leg, step)
         else:
-            assert ratio <= 1.05, (case, leg, ratio)
+            assert ratio <= 1.0, (case, leg, ratio)  # measured 0.35
 
 
 def test_root_motion_defaults_to_the_object_when_the_legs_share_no_bone(empty_scene):

@@ -1,6 +1,7 @@
 // The leg IK over a whole bake: each leg runs through the frames in order, each solve
 // warm-started from the frame before (seed 3.2); a swing is solved as a whole, so a
 // swinging hoof follows its path without jumps at any frame rate.
+#include <cmath>
 #include <limits>
 
 #include "bake_stages.hpp"
@@ -20,6 +21,10 @@ constexpr Real kStanceTolerance = 1e-3;
 // A planted foot further than this (m) from its target is a visible slide: only then
 // may its solve restart cold, into another leg configuration.
 constexpr Real kStanceSlide = 3e-3;
+// Smoothing passes over a stance whose joint turns fast in one frame (LegIk::relax).
+constexpr int kRelaxPasses = 24;
+// A planted joint turning faster than this (rad/s, 1200 deg/s) is spread (LegIk::relax).
+constexpr Real kSnapRate = 1200 * kPi / 180;
 // Shares of the gait's swing lift tried, in order, for a swing the leg cannot follow.
 constexpr Real kLiftScales[] = {1.0, 0.75, 0.5, 0.25, 0.0};
 
@@ -184,14 +189,17 @@ class LegIk {
 
   // Where both the forward and the backward solve follow the path, crosses from one to
   // the other, each frame re-solved from a blend of the two. False if no frame has both.
-  bool cross(const SwingTrack& ahead, const SwingTrack& back, SwingTrack& crossed, bool planted = false) const {
+  // With `whole`, the crossing spreads over the whole span (a stance's change of
+  // configuration over every planted frame instead of the few where both hold).
+  bool cross(const SwingTrack& ahead, const SwingTrack& back, SwingTrack& crossed, bool planted = false,
+             bool whole = false) const {
     const Real follows = planted ? kStanceTolerance : kSwingTolerance;
     int ahead_end = 0;  // frames [0, ahead_end) follow going forward
     while (ahead_end < count_ && ahead.error[ahead_end] <= follows) ++ahead_end;
     int back_start = count_;  // frames [back_start, count) follow going backward
     while (back_start > 0 && back.error[back_start - 1] <= follows) --back_start;
-    if (back_start >= ahead_end) return false;
-    const int w0 = back_start, w1 = ahead_end;  // crossing window [w0, w1)
+    if (!whole && back_start >= ahead_end) return false;
+    const int w0 = whole ? -1 : back_start, w1 = whole ? count_ : ahead_end;  // crossing window [w0, w1)
     crossed = ahead;
     crossed.worst = 0;
     LegIkState cs = state_;
@@ -232,15 +240,79 @@ class LegIk {
     set_goals(1);
     SwingTrack best;
     forward(best, true);
-    if (best.worst > kStanceTolerance && first_ + count_ > 2) {
+    if ((best.worst > kStanceTolerance || snaps(best)) && first_ + count_ > 2) {
       Real lift_off[kMaxBones];
       std::copy(best.angles.end() - n_, best.angles.end(), lift_off);
       solve_ccd(chain_, goals2_[count_ - 1], in_.ccd_iterations, kIkTolerance, lift_off, true);
-      SwingTrack back, crossed;
+      SwingTrack back, crossed, spread;
       backward(lift_off, back, true);
       if (cross(best, back, crossed, true) && crossed.worst < best.worst) best = crossed;
+      // Crossed over a few frames the leg can turn fast (a hoof joint swinging over to
+      // the lift-off configuration); spread over the whole stance it turns slowly, and
+      // wins if it holds the foot as well.
+      cross(best, back, spread, true, true);
+      if (spread.worst <= std::max(best.worst, kStanceTolerance) && largest_turn(spread) < largest_turn(best)) {
+        best = spread;
+      }
     }
+    if (snaps(best)) relax(best);
     finish_span(best);
+  }
+
+  // Spreads a joint's fast turn over the frames around it: each frame re-solved, holding
+  // the foot, by least change from the average of its pose and its neighbours' (a few
+  // Jacobi passes of a smoothing, so a turn the configuration needs is kept, only
+  // slower). The touch-down neighbour is the swing's last pose.
+  void relax(SwingTrack& track) const {
+    std::vector<Real> next(track.angles.size());
+    for (int pass = 0; pass < kRelaxPasses; ++pass) {
+      Real worst = 0;
+      for (int i = 0; i < count_; ++i) {
+        const Real* before = i == 0 ? state_.angles : track.angles.data() + (i - 1) * n_;
+        const Real* here = track.angles.data() + i * n_;
+        const Real* after = i + 1 < count_ ? here + n_ : here;
+        Real* pose = next.data() + i * n_;
+        for (int b = 0; b < n_; ++b) pose[b] = (before[b] + 2 * here[b] + after[b]) / 4;
+        const Real error = solve_dls(chain_, goals2_[i], 4 * in_.ccd_iterations, kIkTolerance, pose).error;
+        if (error > std::max(track.error[i], kStanceTolerance)) {
+          std::copy(here, here + n_, pose);
+        } else {
+          track.error[i] = error;
+        }
+        worst = std::max(worst, track.error[i]);
+      }
+      track.angles.swap(next);
+      track.worst = worst;
+    }
+  }
+
+  // Whether a joint of `track` turns in one frame more than 3x its neighbouring frames'
+  // change (+1 deg), or faster than kSnapRate: the warm start passing near a singular
+  // pose or a limit.
+  bool snaps(const SwingTrack& track) const {
+    for (int i = 1; i + 1 < count_; ++i) {
+      const Real* a = track.angles.data() + (i - 1) * n_;
+      for (int b = 0; b < n_; ++b) {
+        const Real here = std::abs(a[n_ + b] - a[b]);
+        const Real before = i >= 2 ? std::abs(a[b] - a[b - n_]) : Real(0);
+        const Real after = i + 2 <= count_ ? std::abs(a[2 * n_ + b] - a[n_ + b]) : Real(0);
+        if (here > 3 * std::max(before, after) + kPi / 180 || here > kSnapRate / in_.fps) return true;
+      }
+    }
+    return false;
+  }
+
+  // The largest change of any joint between consecutive frames of `track`, from the
+  // pose before it.
+  Real largest_turn(const SwingTrack& track) const {
+    Real turn = 0;
+    const Real* before = state_.angles;
+    for (int i = 0; i < count_; ++i) {
+      const Real* now = track.angles.data() + i * n_;
+      for (int b = 0; b < n_; ++b) turn = std::max(turn, std::abs(now[b] - before[b]));
+      before = now;
+    }
+    return turn;
   }
 
   void finish_span(const SwingTrack& best) {
