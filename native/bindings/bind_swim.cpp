@@ -343,8 +343,12 @@ void bind_swim(py::module_& m) {
             }
             swim::FinWave wave{fin_motion_from(motion), amplitude, feathering, feather_on_power, wavelength, 3};
             float* o = target.mutable_data();
-            py::gil_scoped_release release;
-            b.displace(wave, phase, swim::probe_rotation(before, now), o);
+            {
+              py::gil_scoped_release release;
+              b.displace(wave, phase, swim::probe_rotation(before, now), o);
+            }
+            require_finite_result(o, 3 * b.count(),
+                                  "out: probes_rest / probes_now give no finite displacement (degenerate probes)");
           },
           py::arg("motion"), py::arg("amplitude"), py::arg("phase"), py::arg("feathering"), py::arg("wavelength"),
           py::arg("feather_on_power"), py::arg("probes_rest"), py::arg("probes_now"), py::arg("out"),

@@ -4,8 +4,8 @@
 
 #include <algorithm>
 #include <array>
-#include <utility>
 #include <cmath>
+#include <utility>
 #include <stdexcept>
 
 #include "kodawari/parallel.hpp"
@@ -186,7 +186,13 @@ Mat3 probe_rotation(const Vec3List& rest, const Vec3List& now) {
     before.col(c) = rest[c + 1] - rest[0];
     moved.col(c) = now[c + 1] - now[0];
   }
-  const Mat3 map = moved * before.inverse();
+  // The rotation part of the arms' linear map. Arms that span no volume (collapsed or
+  // collinear probes) have no inverse: then the best rotation of the arms onto each other
+  // (Kabsch: the cross-covariance moved * before^T), which is the identity for zero arms.
+  const double scale = before.norm();
+  const bool invertible = scale > 0 && std::abs(before.determinant()) > 1e-9 * scale * scale * scale;
+  Mat3 map = invertible ? Mat3(moved * before.inverse()) : Mat3(moved * before.transpose());
+  if (!map.allFinite()) map = Mat3::Identity();
   Eigen::JacobiSVD<Mat3> svd(map, Eigen::ComputeFullU | Eigen::ComputeFullV);
   Mat3 u = svd.matrixU();
   Mat3 r = u * svd.matrixV().transpose();
