@@ -29,9 +29,11 @@ def kinetic_and_gravitational(chain):
 
 # Heavy damping on long strands still gains a little once the strand hangs (measured: 0.002 J
 # at 32 bones, 0.17 J and 0.12 J at 64, against 70-190 J lost): not solved yet, shown as such.
-# Measured cause so far: under the root's tension the length projection's Newton steps do not
-# converge (about 350 of 600 substeps at 64 bones, 4 substeps) and the joint-by-joint closing
-# pass that follows turns each substep's gravity drop into sideways speed.
+# Measured cause: the root's bone carries the whole chain; once the tension (about n g dt²
+# over a substep) passes a bone length, the length projection moves kinked joints sideways
+# past the straight line, and each substep's gravity drop comes back as sideways speed
+# (docs/algorithms.md §3.3). Splitting substeps by tension fixes these three but slows the
+# settling of 24-64-bone strands at the defaults past 10 s, so it is not merged yet.
 STILL_GAINS = pytest.mark.xfail(
     strict=True, reason="heavy damping on long strands still gains energy"
 )
