@@ -28,7 +28,7 @@ if [ -z "${BENCH_ONLY:-}" ]; then
   for program in "$BUILD"/bench_*; do
     [ -x "$program" ] || continue
     echo "=== $(basename "$program") (native, the solver alone)"
-    "$program" --benchmark_min_time=0.2 2>&1 | grep -v "^\*\*\*" || failed+=("$program")
+    "$program" --benchmark_min_time=0.2 2>&1 | grep --line-buffered -v "^\*\*\*" || failed+=("$program")
   done
 fi
 wants() { [[ " $BENCH_BLENDERS " == *" $1 "* ]]; }
@@ -36,7 +36,7 @@ if wants 3.4; then
   for script in "${scripts[@]}"; do
     echo "=== $script (Blender 3.4)"
     env $(blender_env) "$BLENDER" "${BLENDER_ARGS[@]}" --python tools/blender_install_addon.py --python "$script" \
-      2>&1 | grep -vE "^(Blender quit|Read blend|Info: |Modules Installed|addon_utils.disable)" || failed+=("$script (Blender 3.4)")
+      2>&1 | grep --line-buffered -vE "^(Blender quit|Read blend|Info: |Modules Installed|addon_utils.disable)" || failed+=("$script (Blender 3.4)")
   done
 fi
 # The same scripts under the bpy modules (4.5 LTS, 5.0), where present.
@@ -48,7 +48,7 @@ for python in "${VENV:-$PWD/.venv}/bin/python" "${VENV5:-$PWD/.venv-bpy5}/bin/py
     echo "=== $script (bpy $version)"
     env $(blender_env) "$python" -c "import runpy, sys; sys.path.insert(0, 'tools')
 from blender_install_addon import install_addon; install_addon(); runpy.run_path(sys.argv[1], run_name='__main__')" \
-      "$script" 2>&1 | grep -vE "^(Blender quit|Read blend|Info: |Modules Installed|addon_utils.disable)" || failed+=("$script (bpy $version)")
+      "$script" 2>&1 | grep --line-buffered -vE "^(Blender quit|Read blend|Info: |Modules Installed|addon_utils.disable)" || failed+=("$script (bpy $version)")
   done
 done
 echo "=== speed table (tools/bench_table.py out/bench.json), whole run $(( $(date +%s) - started )) s"

@@ -25,3 +25,27 @@ def can_swim(obj):
 
 def can_rig(obj):
     return obj is not None and obj.type == "ARMATURE"
+
+
+def add_panel(idname, label, tab, can_use, uses, operator, text, icon):
+    """A headerless Properties panel holding one "Add …" button, shown on an object that could
+    use a feature but does not yet (the single entry the feature's own panels give way to)."""
+    import bpy
+
+    def poll(cls, context):
+        return can_use(context.object) and not uses(context.object)
+
+    def draw(self, context):
+        self.layout.operator(operator, text=text, icon=icon)
+
+    return type(idname, (bpy.types.Panel,), {
+        "__doc__": f'On an object that could use it: one "{text}" button.',
+        "bl_idname": idname,
+        "bl_label": label,
+        "bl_space_type": "PROPERTIES",
+        "bl_region_type": "WINDOW",
+        "bl_context": tab,
+        "bl_options": {"HIDE_HEADER"},
+        "poll": classmethod(poll),
+        "draw": draw,
+    })

@@ -192,9 +192,14 @@ void bind_swim(py::module_& m) {
         const Vec3List points = to_points(axis);
         const float* v = verts.data();
         float* o = target.mutable_data();
+        no_overlap(target, "out", verts, "vertices");
         py::gil_scoped_release release;
-        swim::fin_axis_coordinates(points, up_direction, v, static_cast<std::size_t>(begin),
-                                   static_cast<std::size_t>(end), o);
+        try {
+          swim::fin_axis_coordinates(points, up_direction, v, static_cast<std::size_t>(begin),
+                                     static_cast<std::size_t>(end), o);
+        } catch (const std::invalid_argument& e) {  // the core names its own terms: say which argument
+          throw std::invalid_argument(std::string("axis_points: ") + e.what());
+        }
       },
       py::arg("axis_points"), py::arg("up"), py::arg("vertices"), py::arg("out"), py::arg("begin"), py::arg("end"),
       "Fin finder, stage 1 (call in chunks for progress): for vertices[begin:end] write (s, side, up) into out: "
@@ -206,7 +211,9 @@ void bind_swim(py::module_& m) {
          double margin, std::size_t min_vertices) {
         auto coords = checked_array<float>(coordinates, "coordinates", -1, 3);
         auto e = checked_edges(edges);
-        if (slices < 1 || sectors < 8) throw py::value_error("slices must be >= 1 and sectors >= 8");
+        if (slices < 1 || slices > 4096 || sectors < 8 || sectors > 4096) {
+          throw py::value_error("slices must be 1..4096 and sectors 8..4096");
+        }
         for (auto [v, n] : {std::pair{outside, "outside"}, {margin, "margin"}}) require_finite(v, n);
         swim::FinFinderOptions options;
         options.slices = slices;
@@ -236,6 +243,7 @@ void bind_swim(py::module_& m) {
       [](const py::handle& points, const py::handle& cloud) {
         auto p = checked_array<float>(points, "points", -1, 3);
         auto c = checked_array<float>(cloud, "cloud", -1, 3);
+        if (c.shape(0) == 0) throw py::value_error("cloud is empty: there is no nearest point");
         const float* pd = p.data();
         const float* cd = c.data();
         const std::size_t n = static_cast<std::size_t>(p.shape(0)), m = static_cast<std::size_t>(c.shape(0));
@@ -249,7 +257,7 @@ void bind_swim(py::module_& m) {
         return out;
       },
       py::arg("points"), py::arg("cloud"),
-      "float64 (N,): each float32 point's distance to the nearest point of the float32 (M, 3) cloud (inf if empty).");
+      "float64 (N,): each float32 point's distance to the nearest point of the float32 (M, 3) cloud (M >= 1).");
   m.def(
       "swim_fin_reach",
       [](const py::handle& vertices, const py::handle& edges, const py::handle& in_fin, double seed_radius) {
@@ -282,16 +290,17 @@ void bind_swim(py::module_& m) {
       "(reach float64 (N,), source int64 (N,)): for fin vertices, the path length across the fin from where it "
       "meets the body (0 elsewhere), and the vertex at the root that path starts from.");
   py::class_<swim::FinPartBinding, std::shared_ptr<swim::FinPartBinding>>(
-      m, "FinPart", "One fin part bound for motion: every vertex swings about its own root point, faded in by weight.")
+      m, "FinPart", "One fin part bound for motion: every vertex swings about its own root point, faded in by weight "
+      "(fade > 0: weight × smoothstep(reach / fade), the swing bent along the fin so no line stretches).")
       .def(py::init([](const py::handle& points, const py::handle& reach, const py::handle& weight,
                        const py::handle& root, const py::handle& outward, const py::handle& tangent,
                        const py::handle& side, const py::handle& up, double height, double base_length,
-                       double base_front) {
+                       double base_front, double fade) {
              auto p = checked_array<float>(points, "points", -1, 3);
              const py::ssize_t m = p.shape(0);
              auto r = checked_array<double>(reach, "reach", m, 0);
              auto w = checked_array<double>(weight, "weight", m, 0);
-             for (auto [v, n] : {std::pair{height, "height"}, {base_length, "base_length"}, {base_front, "base_front"}}) {
+             for (auto [v, n] : {std::pair{height, "height"}, {base_length, "base_length"}, {base_front, "base_front"}, {fade, "fade"}}) {
                require_finite(v, n);
              }
              Vec3List pts(static_cast<std::size_t>(m));
@@ -305,11 +314,12 @@ void bind_swim(py::module_& m) {
              rest.base_length = base_length;
              rest.base_front = base_front;
              return std::make_shared<swim::FinPartBinding>(
-                 pts, std::vector<Real>(r.data(), r.data() + m), std::vector<Real>(w.data(), w.data() + m), rest);
+                 pts, std::vector<Real>(r.data(), r.data() + m), std::vector<Real>(w.data(), w.data() + m), rest,
+                 fade);
            }),
            py::arg("points"), py::arg("reach"), py::arg("weight"), py::arg("root"), py::arg("outward"),
            py::arg("tangent"), py::arg("side"), py::arg("up"), py::arg("height"), py::arg("base_length"),
-           py::arg("base_front"))
+           py::arg("base_front"), py::arg("fade") = 0.0)
       .def_property_readonly("count", &swim::FinPartBinding::count)
       .def_property_readonly("max_roll", &swim::FinPartBinding::max_roll)
       .def_property_readonly("max_undulation", &swim::FinPartBinding::max_undulation)

@@ -5,6 +5,7 @@ code, not only the first check) and calls the entry point with them. `outputs` n
 arguments the call writes into; `alias` pairs (output, input) the fuzzer may make
 share memory. Objects with state (RodSystem, AxisBinding) are built anew per case."""
 
+import functools
 import os
 import re
 import sys
@@ -178,6 +179,92 @@ def _set_cache_budget(budget):
     return system.cache_budget, system.cache_bytes, system.cached_frames(), _rod_state(system)
 
 
+def _fin_part_args():
+    heights = np.repeat(np.linspace(0.0, 0.1, 6), 5)
+    along = np.tile(np.linspace(0.0, 0.2, 5), 6)
+    return {
+        "points": np.stack([along, np.zeros_like(along), heights], axis=1).astype(np.float32),
+        "reach": heights.copy(),
+        "weight": np.ones_like(heights),
+        "root": np.array([0.1, 0.0, 0.0]),
+        "outward": np.array([0.0, 0.0, 1.0]),
+        "tangent": np.array([1.0, 0.0, 0.0]),
+        "side": np.array([0.0, 1.0, 0.0]),
+        "up": np.array([0.0, 0.0, 1.0]),
+        "height": 0.1,
+        "base_length": 0.2,
+        "base_front": 0.0,
+    }
+
+
+def _fin_part():
+    return kn.FinPart(**_fin_part_args())
+
+
+def _displace_args():
+    probes = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]], dtype=np.float32)
+    return {
+        "motion": "FLAP",
+        "amplitude": 0.5,
+        "phase": 1.2,
+        "feathering": 0.1,
+        "wavelength": 1.0,
+        "feather_on_power": False,
+        "probes_rest": probes,
+        "probes_now": probes[[0, 2, 1, 3]].copy(),
+        "out": np.zeros((30, 3), np.float32),
+    }
+
+
+@functools.cache
+def _disc():
+    """tests/python's round fish with a dorsal plate: vertices, edges, fin mask, axis coordinates."""
+    from test_swim_kernels import _disc_fish
+
+    vertices, edges, fin = _disc_fish()
+    coords = np.empty_like(vertices)
+    axis2 = np.array([[0.5, 0, 0], [-0.5, 0, 0]], dtype=np.float64)
+    kn.swim_fin_axis_coordinates(
+        axis2, np.array([0.0, 0.0, 1.0]), vertices, coords, 0, len(vertices)
+    )
+    return vertices, edges, fin, coords
+
+
+def _fin_finder_args():
+    vertices, edges, _, coords = _disc()
+    return {
+        "coordinates": coords.copy(),
+        "edges": edges.copy(),
+        "slices": 48,
+        "sectors": 32,
+        "outside": 1.2,
+        "margin": 0.004,
+        "min_vertices": 8,
+    }
+
+
+def _axis_coordinates_args():
+    vertices = _disc()[0]
+    return {
+        "axis_points": np.array([[0.5, 0, 0], [0.0, 0.05, 0], [-0.5, 0, 0]]),
+        "up": np.array([0.0, 0.0, 1.0]),
+        "vertices": vertices.copy(),
+        "out": np.zeros_like(vertices),
+        "begin": 0,
+        "end": len(vertices),
+    }
+
+
+def _fin_reach_args():
+    vertices, edges, fin, _ = _disc()
+    return {
+        "vertices": vertices.copy(),
+        "edges": edges.copy(),
+        "in_fin": fin.copy(),
+        "seed_radius": 1e-6,
+    }
+
+
 def _fin_args():
     return {
         "rest_points": np.column_stack([np.zeros(5), np.linspace(0, 0.4, 5), np.zeros(5)]),
@@ -310,6 +397,33 @@ TARGETS = [
         },
         kn.swim_speed,
     ),
+    Target("swim_bainbridge_applies", lambda: {"frequency": 6.0}, kn.swim_bainbridge_applies),
+    Target(
+        "swim_fin_axis_coordinates",
+        _axis_coordinates_args,
+        kn.swim_fin_axis_coordinates,
+        outputs=("out",),
+        alias=(("out", "vertices"),),
+        examples=60,
+    ),
+    Target("swim_find_fins", _fin_finder_args, kn.swim_find_fins, examples=60),
+    Target(
+        "swim_nearest_distances",
+        lambda: {"points": _disc()[0][:50].copy(), "cloud": _disc()[0].copy()},
+        kn.swim_nearest_distances,
+    ),
+    Target("swim_fin_reach", _fin_reach_args, kn.swim_fin_reach, examples=60),
+    Target("FinPart", _fin_part_args, kn.FinPart, examples=80),
+    Target(
+        "FinPart.displace",
+        _displace_args,
+        _method(_fin_part, "displace"),
+        outputs=("out",),
+        examples=80,
+    ),
+    Target("FinPart.count", dict, lambda: _fin_part().count, examples=1),
+    Target("FinPart.max_roll", dict, lambda: _fin_part().max_roll, examples=1),
+    Target("FinPart.max_undulation", dict, lambda: _fin_part().max_undulation, examples=1),
     # --- rod
     Target(
         "view_weights",
@@ -546,7 +660,7 @@ def signature_names(func):
     return tuple(re.findall(r"(\w+): ", first[0].split(") ->")[0])) if first else ()
 
 
-_INSTANCES = {"RodSystem": _chain_system, "AxisBinding": _binding}
+_INSTANCES = {"RodSystem": _chain_system, "AxisBinding": _binding, "FinPart": _fin_part}
 
 
 def generic_target(name):

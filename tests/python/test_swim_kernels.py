@@ -225,6 +225,31 @@ def test_fin_part_swings_each_vertex_about_its_own_root():
     assert np.abs(out[:5]).max() == 0.0  # the root row stays on the body
 
 
+def test_fin_part_fade_bends_lines_across_the_fin_without_stretching_them():
+    """Issue 10 item 2: with the fade in the core (fade > 0), the swing is bent along each
+    line across the fin, so no segment of a line stretches however steep the fade; the
+    old per-vertex lever r·(R(w(r)·angle) − I)·n stretched them by up to ~1.5x at 0.6 rad."""
+    heights = np.repeat(np.linspace(0.0, 0.1, 21), 5)
+    along = np.tile(np.linspace(0.0, 0.2, 5), 21)
+    points = np.stack([along, np.zeros_like(along), heights], axis=1).astype(np.float32)
+    frame = ([1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0])
+    args = [np.array([0.1, 0.0, 0.0]), np.array([0.0, 0.0, 1.0])] + [np.array(v) for v in frame]
+    part = kn.FinPart(
+        points, heights.copy(), np.ones_like(heights), *args, 0.1, 0.2, 0.0, fade=0.035
+    )
+    probes = np.ascontiguousarray([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]], dtype=np.float32)
+    out = np.empty_like(points)
+    for motion in ("FLAP", "UP_DOWN"):
+        for phase in (math.pi / 2, -math.pi / 2):
+            part.displace(motion, 0.6, phase, 0.0, 1.0, False, probes, probes, out)
+            columns = (points + out).reshape(21, 5, 3)
+            segments = np.linalg.norm(np.diff(columns, axis=0), axis=2)
+            assert np.allclose(segments, 0.005, rtol=2e-3), (motion, segments.max() / 0.005)
+            assert np.abs(out[:5]).max() == 0.0  # the root row stays on the body
+            tip = columns[-1, 0] - columns[0, 0]
+            assert np.linalg.norm(tip - [0, 0, 0.1]) > 0.03  # and the fin did swing
+
+
 # Each preset's body wave (wavelength, tail and snout amplitude, envelope start and power).
 PRESET_WAVES = {
     "ANGUILLIFORM": (0.6, 0.05, 0.025, 0.0, 1.0),

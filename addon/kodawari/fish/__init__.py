@@ -1,12 +1,12 @@
 """Fish swim: any fish mesh swims by bending along a control axis (docs/algorithms.md §1, §2).
 
-Object.kodawari_swim holds the settings; runtime.py evaluates on frame changes
-into the "Kodawari Swim" shape key; ops.py adds, tunes, bakes and removes.
+Object.kodawari_swim holds the settings; runtime.py evaluates into the "Kodawari Swim"
+shape key, called by handlers.py on frame changes; ops.py adds, tunes, bakes and removes.
 """
 
 import bpy
 
-from . import apply, ops, panel, props, runtime, visibility
+from . import apply, handlers, ops, panel, props
 
 CLASSES = (
     props.KodawariSwimFin,
@@ -32,7 +32,10 @@ PROPERTIES = (
 )
 
 HANDLERS = (
-    ("frame_change_post", runtime.on_frame_change),
-    ("load_post", runtime.on_load),
-    *visibility.HANDLERS,
+    ("frame_change_post", handlers.on_frame_change),
+    ("load_post", handlers.on_load),
+    ("render_init", handlers.on_render_init),
+    ("render_pre", handlers.on_render_pre),
+    ("render_complete", handlers.on_render_done),
+    ("render_cancel", handlers.on_render_done),
 )

@@ -17,7 +17,7 @@ class FinPart:
     vertex swings about its own root point, faded in from the body (a group holding a
     left and a right pectoral fin becomes two parts that beat as mirror images)."""
 
-    def __init__(self, fin_index, indices, weights, rest, reach, root, tip, frame, base, kn):
+    def __init__(self, fin_index, indices, weights, rest, reach, root, tip, frame, base, fade, kn):
         self.fin_index = fin_index
         self.indices = indices  # int64 (M,) vertex indices into the mesh
         self.rest = rest  # float32 (M, 3) rest positions
@@ -36,6 +36,7 @@ class FinPart:
             max(height, 1e-9),
             max(base[1] - base[0], 1e-9),
             base[0],
+            fade,
         )
         self.out = np.empty_like(rest)
 
@@ -57,11 +58,6 @@ def _blade_facing(rest, direction, frame, kn):
     # Roll toward the stroke direction (rotation about the fin axis, right-handed).
     sign = 1.0 if float(np.cross(normal, stroke) @ direction) >= 0 else -1.0
     return on_power, sign
-
-
-def _smoothstep(x):
-    x = np.clip(x, 0.0, 1.0)
-    return x * x * (3.0 - 2.0 * x)
 
 
 def body_frame_at(point, body_axis, up):
@@ -153,15 +149,19 @@ def build_parts(fin_index, fin, group_weights, verts, body_axis, up, kn, reach_a
         base = (float(along.min()), float(along.max()))
         if fin.motion == "UNDULATE" and base[1] - base[0] < 1e-6:
             raise ValueError(f"vertex group '{fin.vertex_group}' has no length along the body")
-        # The motion fades in over the first root_blend of the fin (SEEDS §1: the root
-        # must not move, or the fin tears from the body).
+        # The motion fades in over the first root_blend of the fin (docs/algorithms.md
+        # §2.5: the root must not move, or the fin tears from the body).
         # An undulation's sideways wave fades in over the whole fin height: over a short
         # root band it would shear the fin's base (its amplitude is a share of the height).
+        # The fade is a smoothstep over a share of the fin's own height (not a fixed
+        # distance), applied in the core, which also bends the swing along the fin.
         span = 1.0 if fin.motion == "UNDULATE" else fin.root_blend
-        blend = _smoothstep(r / max(span, 1e-3))
-        weights = group_weights[part_indices] * blend
+        fade = max(span, 1e-3) * (hi - lo)
+        weights = group_weights[part_indices].astype(np.float64)
         rest = np.ascontiguousarray(verts[part_indices], dtype=np.float32)
         parts.append(
-            FinPart(fin_index, part_indices, weights, rest, reach - lo, root, tip, frame, base, kn)
+            FinPart(
+                fin_index, part_indices, weights, rest, reach - lo, root, tip, frame, base, fade, kn
+            )
         )
     return parts

@@ -225,21 +225,8 @@ class KODAWARI_PT_swim_order(_SwimPanel, bpy.types.Panel):
             col.label(text=f"{index}. {modifier.name}", icon=icon, translate=False)
 
 
-class KODAWARI_PT_swim_add(bpy.types.Panel):
-    """On a mesh that does not swim: one "Add Fish Swim" button where the modifiers are."""
-
-    bl_label = "Fish Swim"
-    bl_space_type = "PROPERTIES"
-    bl_region_type = "WINDOW"
-    bl_context = "modifier"
-    bl_options = {"HIDE_HEADER"}
-
-    @classmethod
-    def poll(cls, context):
-        return in_use.can_swim(context.object) and not in_use.swim(context.object)
-
-    def draw(self, context):
-        self.layout.operator("kodawari.swim_add", icon="MOD_WAVE")
+KODAWARI_PT_swim_add = in_use.add_panel("KODAWARI_PT_swim_add", "Fish Swim", "modifier", in_use.can_swim,
+                                         in_use.swim, "kodawari.swim_add", "Add Fish Swim", "MOD_WAVE")
 
 
 CLASSES = (

@@ -27,6 +27,7 @@ def rest_positions(obj):
 
 
 FINGERPRINT_SAMPLES = 32
+ROWING_KINDS = ("PECTORAL", "PELVIC")
 
 
 def rest_fingerprint(obj):
@@ -149,13 +150,19 @@ class SwimRig:
             fin = settings.fins[part.fin_index]
             if fin.amplitude == 0.0 and (fin.motion != "FLAP" or fin.feathering == 0.0):
                 continue
+            feathering = fin.feathering * part.feather_sign
+            if fin.kind not in ROWING_KINDS:
+                # Only paired fins row; a feathered dorsal, anal or caudal fin would yaw
+                # its long base (docs/algorithms.md §2.4): held like a twist.
+                limit = part.binding.max_roll
+                feathering = max(-limit, min(limit, feathering))
             # The core swings each vertex about its own root, faded in from the body, and
             # turns the result with the body's rotation at the root (from the probes).
             part.binding.displace(
                 fin.motion,
                 fin.amplitude,
                 phase * fin.frequency_ratio - fin.phase_lag,
-                fin.feathering * part.feather_sign,
+                feathering,
                 fin.wavelength,
                 part.feather_on_power,
                 self.probes_rest[4 * k : 4 * k + 4],

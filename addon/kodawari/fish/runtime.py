@@ -1,6 +1,6 @@
-"""Live evaluation: a frame_change_post handler writes each swimming object's
-deformed positions into its "Kodawari Swim" shape key; load_post drops the
-runtime state so it is rebuilt from the saved settings.
+"""Live evaluation: writes each swimming object's deformed positions into its
+"Kodawari Swim" shape key (handlers.py calls it on frame changes and file loads;
+a load drops the runtime state so it is rebuilt from the saved settings).
 
 Runtime state (the bound rigs) lives only in memory, keyed by object; anything
 that could make it stale (undo, a new file, changed binding settings, another
@@ -11,7 +11,6 @@ import contextlib
 
 import bpy
 import mathutils
-from bpy.app.handlers import persistent
 
 from .. import bulk, problems
 from . import path, timing, visibility
@@ -177,33 +176,3 @@ def separate_linked_duplicates(scene):
                 f"Kodawari Swim: '{obj.name}' shared its mesh with '{owner.name}' (a linked "
                 f"duplicate); it now has its own copy so each swims with its own settings"
             )
-
-
-@persistent
-def on_frame_change(scene, depsgraph=None):
-    separate_linked_duplicates(scene)
-    for obj in scene.objects:
-        if obj.type != "MESH" or not is_live(obj):
-            continue
-        try:
-            evaluate(obj, scene)
-        except Exception as exc:  # noqa: BLE001 - one broken fish never stops the others
-            problems.report(obj, "swim", exc)
-        else:
-            problems.clear(obj, "swim")
-
-
-@persistent
-def on_load(_dummy=None, *_args):
-    # Rigs belong to the old file's objects; the first frame change rebuilds them
-    # from the saved settings. Evaluate now so the opened file shows the swim pose.
-    forget()
-    scene = bpy.context.scene
-    if scene is None:
-        return
-    for obj in scene.objects:
-        if obj.type == "MESH" and is_live(obj):
-            try:
-                evaluate(obj, scene)
-            except Exception as exc:  # noqa: BLE001 - one broken fish never stops the others
-                problems.report(obj, "swim", exc)

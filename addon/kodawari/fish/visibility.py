@@ -5,8 +5,6 @@ before every modifier. Hiding the swim mutes that key, so the rest shape shows (
 renders) and the user's modifiers see the undeformed mesh. While a render job runs,
 the render toggle decides instead of the viewport one."""
 
-from bpy.app.handlers import persistent
-
 from .rig import SHAPE_KEY
 
 _rendering = [False]
@@ -41,30 +39,10 @@ def _sync_scene(scene):
             sync(obj)
 
 
-@persistent
-def on_render_init(scene, *_args):
-    _rendering[0] = True
+def set_rendering(scene, rendering):
+    """From the render handlers (handlers.py): which toggle decides, applied to the scene."""
+    _rendering[0] = rendering
     _sync_scene(scene)
-
-
-@persistent
-def on_render_pre(scene, *_args):
-    _rendering[0] = True
-    _sync_scene(scene)
-
-
-@persistent
-def on_render_done(scene, *_args):
-    _rendering[0] = False
-    _sync_scene(scene)
-
-
-HANDLERS = (
-    ("render_init", on_render_init),
-    ("render_pre", on_render_pre),
-    ("render_complete", on_render_done),
-    ("render_cancel", on_render_done),
-)
 
 
 def draw_toggles(layout, settings):

@@ -3,7 +3,7 @@ CCD IK with joint limits and stiffness, baked to an Action (docs/algorithms.md Â
 
 import bpy
 
-from . import ops, panel, props, runtime
+from . import handlers, ops, panel, props
 
 CLASSES = (
     props.KodawariGaitBone,
@@ -21,5 +21,5 @@ PROPERTIES = (
 )
 
 HANDLERS = (
-    ("load_post", runtime.on_load_post),
+    ("load_post", handlers.on_load),
 )

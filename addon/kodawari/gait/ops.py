@@ -78,8 +78,8 @@ class KODAWARI_OT_gait_setup(bpy.types.Operator):
         if root_motion == "AUTO":
             root_motion = "BONE" if body is not None else "OBJECT"
         if root_motion == "BONE" and body is None:
-            return "No body bone: the four legs have no common parent bone to carry root motion " \
-                   "(use Root Motion: Armature Object)"
+            return ("No body bone: the four legs have no common parent bone to carry root motion "
+                    "(use Root Motion: Armature Object)")
         # Validate the geometry before touching the settings.
         forward = rigmod.forward_of(obj, legs)
         probe = {"forward": forward, "body_head": np.zeros(3), "body_rest": np.eye(3), "legs": []}

@@ -166,21 +166,8 @@ GAIT_ROW_PANELS = tuple(_gait_row_panel(identifier) for identifier, _, _ in GAIT
 LEG_PANELS = tuple(_leg_panel(name) for name in LEG_NAMES)
 
 # Parents before children.
-class KODAWARI_PT_gait_add(bpy.types.Panel):
-    """On an armature without a gait setup: one "Gait Setup" button."""
-
-    bl_label = "Kodawari Gait"
-    bl_space_type = "PROPERTIES"
-    bl_region_type = "WINDOW"
-    bl_context = "object"
-    bl_options = {"HIDE_HEADER"}
-
-    @classmethod
-    def poll(cls, context):
-        return in_use.can_rig(context.object) and not in_use.gait(context.object)
-
-    def draw(self, context):
-        self.layout.operator("kodawari.gait_setup", text="Set Up Gait (find legs)", icon="ANIM")
+KODAWARI_PT_gait_add = in_use.add_panel("KODAWARI_PT_gait_add", "Kodawari Gait", "object", in_use.can_rig,
+                                         in_use.gait, "kodawari.gait_setup", "Set Up Gait (find legs)", "ANIM")
 
 
 CLASSES = (KODAWARI_PT_gait_add, KODAWARI_PT_gait, KODAWARI_PT_gait_rig, KODAWARI_PT_gait_table, *GAIT_ROW_PANELS,

@@ -191,21 +191,8 @@ class KODAWARI_PT_hair_colliders(_HairPanel, bpy.types.Panel):
             col.prop(collider, "offset")
 
 
-class KODAWARI_PT_hair_add(bpy.types.Panel):
-    """On an armature without rods: one "Add Hair Rod" button."""
-
-    bl_label = "Kodawari Hair"
-    bl_space_type = "PROPERTIES"
-    bl_region_type = "WINDOW"
-    bl_context = "data"
-    bl_options = {"HIDE_HEADER"}
-
-    @classmethod
-    def poll(cls, context):
-        return in_use.can_rig(context.object) and not in_use.hair(context.object)
-
-    def draw(self, context):
-        self.layout.operator("kodawari.rod_add", text="Add Hair Rod (selected bones)", icon="STRANDS")
+KODAWARI_PT_hair_add = in_use.add_panel("KODAWARI_PT_hair_add", "Kodawari Hair", "data", in_use.can_rig,
+                                         in_use.hair, "kodawari.rod_add", "Add Hair Rod (selected bones)", "STRANDS")
 
 
 CLASSES = (KODAWARI_UL_hair_rods, KODAWARI_UL_hair_keys, KODAWARI_UL_hair_colliders, KODAWARI_PT_hair_add,

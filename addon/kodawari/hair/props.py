@@ -15,7 +15,6 @@ CONDITIONS = (
     ("POSE", "Pose", "Weighted by how close the reference bone's rotation is to the keyed one"),
     ("SPEED", "Speed", "Weighted by how close the reference bone's speed is to the keyed one"),
 )
-CONDITION_CODES = {"VIEW": 0, "POSE": 1, "SPEED": 2}
 
 
 def _changed(self, context):

@@ -24,7 +24,9 @@ STATE_PROPERTY = "kodawari_hair_state"
 STATE_FRAME_PROPERTY = "kodawari_hair_state_frame"
 NO_CAMERA = "No active camera: view keys fall back to the base shape"
 
-_runtimes = {}
+_runtimes = {}  # by obj.as_pointer(): a rename keeps the simulation (CONTRIBUTING.md)
+# The native RodSystem's codes for a key's condition (Condition in rod_system.hpp).
+CONDITION_CODES = {"VIEW": 0, "POSE": 1, "SPEED": 2}
 # True while evaluate() plays skipped frames through scene.frame_set (their handlers
 # must simulate them in order, not jump again).
 _replaying = False
@@ -74,12 +76,11 @@ def _tag(obj):
 
 class ArmatureRuntime:
     def __init__(self, obj):
-        from . import props
-
         kn = native.module()
         settings = obj.kodawari_hair
         pose_bones = obj.pose.bones
         self.pointer = obj.as_pointer()
+        self.data_pointer = obj.data.as_pointer()
         self.bone_count = len(pose_bones)
         index = {pb.name: i for i, pb in enumerate(pose_bones)}
         self.system = kn.RodSystem(self.bone_count, 0)
@@ -116,7 +117,7 @@ class ArmatureRuntime:
                     radius=rod.radius,
                     wind=np.array(rod.wind, np.float64),
                     key_conditions=np.array(
-                        [props.CONDITION_CODES[k.condition] for k in rod.keys], np.int32
+                        [CONDITION_CODES[k.condition] for k in rod.keys], np.int32
                     ),
                     key_directions=np.array(
                         [tuple(k.direction) for k in rod.keys], np.float64
@@ -304,10 +305,10 @@ def _replay(scene, first, last):
 
 def get(obj, build=True):
     """The runtime of an armature object, built (or rebuilt after a change) on demand."""
-    key = obj.name_full
+    key = obj.as_pointer()
     rt = _runtimes.get(key)
-    if rt is not None and (rt.pointer != obj.as_pointer() or rt.bone_count != len(obj.pose.bones)):
-        rt = None  # another object under the same name, or bones added/removed: rebuild
+    if rt is not None and (rt.data_pointer != obj.data.as_pointer() or rt.bone_count != len(obj.pose.bones)):
+        rt = None  # another armature at a freed object's address, or bones added/removed: rebuild
     if rt is None and build:
         rt = ArmatureRuntime(obj)
         _runtimes[key] = rt
@@ -317,7 +318,7 @@ def get(obj, build=True):
 def invalidate(obj):
     """Settings changed: rebuild at the next frame (the simulation restarts there)."""
     if obj is not None:
-        _runtimes.pop(obj.name_full, None)
+        _runtimes.pop(obj.as_pointer(), None)
 
 
 def clear():

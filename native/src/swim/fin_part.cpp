@@ -3,6 +3,8 @@
 #include <Eigen/Dense>
 
 #include <algorithm>
+#include <array>
+#include <utility>
 #include <cmath>
 #include <stdexcept>
 
@@ -12,7 +14,56 @@ namespace kodawari::swim {
 
 namespace {
 
-constexpr Real kMaxShear = 0.5;
+constexpr Real kMaxShear = 0.35;
+// An undulation's steepest slope (wave along the base and fade across the fin together).
+constexpr Real kMaxUndulationSlope = 0.8;
+constexpr int kFadeSamples = 64;
+
+Real smoothstep(Real x) {
+  x = std::clamp(x, Real(0), Real(1));
+  return x * x * (Real(3) - Real(2) * x);
+}
+
+// The swing integrated along the fin (docs/algorithms.md §2.4): a fin line at reach r
+// bends so that its direction at ρ is turned by angle·w(ρ); its point at r moves by
+// ∫0^r (R(angle·w(ρ)) − I)·outward dρ = S(r)·(a × n) + C(r)·(a × (a × n)). Every
+// line keeps its length, so the fade adds no stretch of its own (a per-vertex lever
+// r·(R(angle·w(r)) − I)·n stretches lines by √(1 + (r·angle·w'(r))²) and then some).
+struct SwingIntegral {
+  Real step = 0, sin_full = 0, cos_full = 0;
+  std::array<Real, kFadeSamples + 1> s{}, c{};
+
+  SwingIntegral(Real angle, Real fade) {
+    sin_full = std::sin(angle);
+    cos_full = Real(1) - std::cos(angle);
+    if (fade <= 0) return;
+    step = fade / kFadeSamples;
+    Real prev_s = 0, prev_c = 0;
+    for (int k = 0; k <= kFadeSamples; ++k) {
+      const Real a = angle * smoothstep(Real(k) / kFadeSamples);
+      const Real ss = std::sin(a), cc = Real(1) - std::cos(a);
+      if (k > 0) {
+        s[k] = s[k - 1] + Real(0.5) * step * (prev_s + ss);
+        c[k] = c[k - 1] + Real(0.5) * step * (prev_c + cc);
+      }
+      prev_s = ss;
+      prev_c = cc;
+    }
+  }
+
+  // (S(r), C(r)).
+  std::pair<Real, Real> at(Real r) const {
+    if (step <= 0) return {r * sin_full, r * cos_full};
+    const Real x = r / step;
+    if (x >= kFadeSamples) {
+      const Real extra = r - step * kFadeSamples;
+      return {s[kFadeSamples] + extra * sin_full, c[kFadeSamples] + extra * cos_full};
+    }
+    const int k = static_cast<int>(std::max(x, Real(0)));
+    const Real t = std::max(x, Real(0)) - k;
+    return {s[k] + t * (s[k + 1] - s[k]), c[k] + t * (c[k + 1] - c[k])};
+  }
+};
 
 Vec3 unit_cross_or(const Vec3& a, const Vec3& b, const Vec3& fallback) {
   const Vec3 c = a.cross(b);
@@ -23,10 +74,14 @@ Vec3 unit_cross_or(const Vec3& a, const Vec3& b, const Vec3& fallback) {
 }  // namespace
 
 FinPartBinding::FinPartBinding(const Vec3List& points, const std::vector<Real>& reach,
-                               const std::vector<Real>& weight, const FinPartRest& rest)
-    : reach_(reach), weight_(weight), rest_(rest) {
+                               const std::vector<Real>& weight_in, const FinPartRest& rest, Real fade)
+    : reach_(reach), weight_(weight_in), group_(weight_in), rest_(rest), fade_(std::max(fade, Real(0))) {
   const std::size_t m = points.size();
-  if (reach.size() != m || weight.size() != m) throw std::invalid_argument("reach and weight need one value per point");
+  if (reach.size() != m || weight_in.size() != m) throw std::invalid_argument("reach and weight need one value per point");
+  if (fade_ > 0) {
+    for (std::size_t i = 0; i < m; ++i) weight_[i] = group_[i] * smoothstep(reach[i] / fade_);
+  }
+  const std::vector<Real>& weight = weight_;
   if (!(rest_.outward.norm() > 0)) throw std::invalid_argument("the fin's outward direction is zero");
   rest_.outward.normalize();
   across_.resize(m);
@@ -68,6 +123,8 @@ void FinPartBinding::displace(const FinWave& wave, Real phase, const Mat3& body_
       hinge_axis = unit_cross_or(outward, f.tangent, f.up);
       angle = wave.amplitude * std::sin(phase);
       const Real toward = wave.feather_on_power ? Real(1) + std::cos(phase) : Real(1) - std::cos(phase);
+      // Not held here: a rowing blade must turn edge-on (the caller holds feathering on
+      // fins that do not row, docs/algorithms.md §2.4).
       roll = wave.feathering * Real(0.5) * toward;
       break;
     }
@@ -83,11 +140,17 @@ void FinPartBinding::displace(const FinWave& wave, Real phase, const Mat3& body_
       // Amplitude is a fraction of the fin's height; the wave may not tilt the fin's
       // surface past 45° (slope 1), which would fold it.
       const Real k = Real(2) * kPi / (std::max(wave.wavelength, Real(1e-6)) * std::max(rest_.base_length, Real(1e-9)));
-      undulation = std::min(wave.amplitude * rest_.height, Real(1) / k);
+      // With the fade's own slope across the fin, the surface may tilt by at most
+      // kMaxUndulationSlope (an edge then stretches by at most √(1 + 0.8²) ≈ 1.28).
+      const Real fade_slope = max_undulation_ > 0 ? kMaxShear / max_undulation_ : Real(0);
+      undulation = std::min(wave.amplitude * rest_.height,
+                            kMaxUndulationSlope / std::sqrt(k * k + fade_slope * fade_slope));
       break;
     }
   }
   const Real k_wave = Real(2) * kPi / std::max(wave.wavelength, Real(1e-6));
+  const SwingIntegral integral(angle, fade_);
+  const Vec3 bend_1 = hinge_axis.cross(outward), bend_2 = hinge_axis.cross(bend_1);
   parallel_for(reach_.size(), 0, 8192, [&](std::size_t begin, std::size_t end) {
   for (std::size_t i = begin; i < end; ++i) {
     const Real w = weight_[i];
@@ -96,10 +159,18 @@ void FinPartBinding::displace(const FinWave& wave, Real phase, const Mat3& body_
       if (wave.motion == FinMotion::Undulate) {
         d = w * undulation * std::sin(phase - k_wave * along_[i]) * f.side;
       } else {
-        // Swing about the vertex's own root point: the lever is its reach across the fin.
+        // Swing about the vertex's own root point, bent along its line across the fin.
         const Mat3 swing = angle != 0 ? axis_rotation(hinge_axis, w * angle) : Mat3::Identity();
         const Mat3 twist = roll != 0 ? axis_rotation(outward, w * roll) : Mat3::Identity();
-        d = (swing - Mat3::Identity()) * (reach_[i] * outward) + swing * (twist - Mat3::Identity()) * across_[i];
+        if (angle != 0) {
+          if (fade_ > 0) {
+            const auto [s_r, c_r] = integral.at(reach_[i]);
+            d = group_[i] * (s_r * bend_1 + c_r * bend_2);
+          } else {
+            d = (swing - Mat3::Identity()) * (reach_[i] * outward);
+          }
+        }
+        d += swing * (twist - Mat3::Identity()) * across_[i];
       }
       d = body_rotation * d;
     }

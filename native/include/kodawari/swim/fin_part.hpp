@@ -1,12 +1,13 @@
 // One fin part bound for motion (docs/algorithms.md §2.4). Replaces a
 // per-fin FFD: every fin vertex swings as if hinged at its OWN root point (the
-// lever is its reach across the fin, along the fin's outward direction),
-// with the motion's angle faded in by a weight that rises from 0 on the body to 1
-// out on the fin. Neighbouring vertices then get nearly the same rotation, so the
-// fade can shear the mesh only by about 0.9·angle (~1.1x edge stretch at 0.6 rad)
-// and a long-based fin (dorsal, anal) never swings its base ends away from the body.
-// An undulation may not tilt the fin past 45°; a TWIST is held to max_roll (the fade
-// shears under 0.5); feathering is not held (a blade must turn edge-on).
+// lever is its reach across the fin, along the fin's outward direction), with the
+// motion's angle faded in by a smoothstep weight that rises from 0 on the body to 1
+// at `fade` reach. The swing is bent along each line across the fin (the integral of
+// the faded rotation), so the fade itself stretches no line; neighbouring vertices get
+// nearly the same rotation and a long-based fin (dorsal, anal) never swings its base
+// ends away from the body. An undulation's slope is held under 0.8; a TWIST is held
+// to max_roll (the fade shears under 0.35); feathering is not held (a rowing blade
+// must turn edge-on; the caller holds it on fins that do not row).
 #pragma once
 
 #include <cstddef>
@@ -29,10 +30,11 @@ struct FinPartRest {
 class FinPartBinding {
  public:
   // points: M rest positions; reach: M path lengths across the fin from the body
-  // (0 at the root); weight: M fade weights in [0, 1] (group weight × root fade);
-  // weight_slope: the largest d(weight)/d(reach), for the caps.
+  // (0 at the root); weight: M weights in [0, 1] (the fin's vertex-group weight);
+  // fade: the reach over which the motion fades in from the body (smoothstep); 0: none,
+  // the weights are used as given.
   FinPartBinding(const Vec3List& points, const std::vector<Real>& reach, const std::vector<Real>& weight,
-                 const FinPartRest& rest);
+                 const FinPartRest& rest, Real fade = 0);
 
   std::size_t count() const { return reach_.size(); }
 
@@ -41,14 +43,15 @@ class FinPartBinding {
   void displace(const FinWave& wave, Real phase, const Mat3& body_rotation, float* out) const;
 
   // The largest roll (twist / feathering) and undulation amplitude (length units)
-  // the fade allows without shearing the mesh by more than 0.5.
+  // the fade allows without shearing the mesh by more than 0.35.
   Real max_roll() const { return max_roll_; }
   Real max_undulation() const { return max_undulation_; }
 
  private:
   Vec3List across_;            // offset from the part's centre line, perpendicular to `outward`
-  std::vector<Real> reach_, weight_, along_, height_;
+  std::vector<Real> reach_, weight_, group_, along_, height_;
   FinPartRest rest_;
+  Real fade_ = 0;
   Real max_roll_ = 0, max_undulation_ = 0;
 };
 

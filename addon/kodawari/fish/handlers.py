@@ -1,0 +1,53 @@
+"""Persistent application handlers of the fish swim: live evaluation on frame changes,
+the swim pose on file load, and the render toggles while a render runs."""
+
+import bpy
+from bpy.app.handlers import persistent
+
+from .. import problems
+from . import runtime, visibility
+
+
+@persistent
+def on_frame_change(scene, depsgraph=None):
+    runtime.separate_linked_duplicates(scene)
+    for obj in scene.objects:
+        if obj.type != "MESH" or not runtime.is_live(obj):
+            continue
+        try:
+            runtime.evaluate(obj, scene)
+        except Exception as exc:  # noqa: BLE001 - one broken fish never stops the others
+            problems.report(obj, "swim", exc)
+        else:
+            problems.clear(obj, "swim")
+
+
+@persistent
+def on_load(_dummy=None, *_args):
+    # Rigs belong to the old file's objects; the first frame change rebuilds them
+    # from the saved settings. Evaluate now so the opened file shows the swim pose.
+    runtime.forget()
+    scene = bpy.context.scene
+    if scene is None:
+        return
+    for obj in scene.objects:
+        if obj.type == "MESH" and runtime.is_live(obj):
+            try:
+                runtime.evaluate(obj, scene)
+            except Exception as exc:  # noqa: BLE001 - one broken fish never stops the others
+                problems.report(obj, "swim", exc)
+
+
+@persistent
+def on_render_init(scene, *_args):
+    visibility.set_rendering(scene, True)
+
+
+@persistent
+def on_render_pre(scene, *_args):
+    visibility.set_rendering(scene, True)
+
+
+@persistent
+def on_render_done(scene, *_args):
+    visibility.set_rendering(scene, False)
