@@ -27,8 +27,13 @@ def kinetic_and_gravitational(chain):
     return 0.5 * float(np.sum(v * v)) + GRAVITY * float(np.sum(x[:, 2]))
 
 
-# Heavy damping on long strands still gains a little (measured: 0.002 J at 32 bones,
-# 0.33 J and 1.24 J at 64, against 70-190 J lost): not solved yet, shown as such.
+# Heavy damping on long strands still gains a little once the strand hangs (measured: 0.002 J
+# at 32 bones, 0.17 J and 0.12 J at 64, against 70-190 J lost): not solved yet, shown as such.
+# Measured cause: the root's bone carries the whole chain; once the tension (about n g dt²
+# over a substep) passes a bone length, the length projection moves kinked joints sideways
+# past the straight line, and each substep's gravity drop comes back as sideways speed
+# (docs/algorithms.md §3.3). Splitting substeps by tension fixes these three but slows the
+# settling of 24-64-bone strands at the defaults past 10 s, so it is not merged yet.
 STILL_GAINS = pytest.mark.xfail(
     strict=True, reason="heavy damping on long strands still gains energy"
 )
@@ -62,6 +67,57 @@ def test_a_strand_without_bending_stiffness_never_gains_energy(bones, damping, s
     assert gains.max() <= 0.0, f"energy grew by {gains.max():.4g} J in one frame"
     lengths = np.linalg.norm(np.diff(chain.positions(), axis=0), axis=1)
     np.testing.assert_allclose(lengths, STRAND_LENGTH / bones, rtol=1e-5)
+
+
+# Measured gains per frame at these corners (bones, stiffness, substeps, iterations): not
+# solved yet, shown as such.
+EXTREMES_STILL_GAINING = {
+    (2, 0.01, 64, 1): 0.032,
+    (2, 0.01, 64, 64): 8.9e-5,
+    (8, 0.01, 64, 64): 0.13,
+    (8, 1.0, 64, 1): 0.12,
+    (16, 1.0, 64, 64): 0.16,
+    (32, 1.0, 64, 64): 0.29,
+}
+EXTREMES = [
+    pytest.param(
+        bones,
+        stiffness,
+        substeps,
+        iterations,
+        marks=pytest.mark.xfail(
+            strict=True, reason="heavily damped strand still gains energy at this corner"
+        )
+        if (bones, stiffness, substeps, iterations) in EXTREMES_STILL_GAINING
+        else (),
+    )
+    for bones in (2, 8, 16, 32, 64)
+    for stiffness in (0.01, 1.0)
+    for substeps in (1, 64)
+    for iterations in (1, 64)
+]
+# Round-off of summing the energy of up to 64 joints: far below anything visible.
+ROUND_OFF = 1e-5
+
+
+@pytest.mark.parametrize(("bones", "stiffness", "substeps", "iterations"), EXTREMES)
+def test_a_heavily_damped_strand_never_gains_energy_at_the_ui_extremes(
+    bones, stiffness, substeps, iterations
+):
+    # Damping 20 1/s (the UI's top) at every corner of stiffness 0.01-1, substeps 1-64 and
+    # iterations 1-64: the strand bends down from its horizontal rest shape and hangs.
+    # Motion and height may only lose energy (beyond round-off).
+    # (Without damping a stiff strand trades energy with its bending, which this sum leaves
+    # out: those settings are covered by the stiffness-0.01 test above.)
+    chain = strand(
+        bones, stiffness=stiffness, damping=20.0, substeps=substeps, iterations=iterations
+    )
+    energy = [kinetic_and_gravitational(chain)]
+    for _ in range(48):
+        chain.step()
+        energy.append(kinetic_and_gravitational(chain))
+    gains = np.diff(energy)
+    assert gains.max() <= ROUND_OFF, f"energy grew by {gains.max():.4g} J in one frame"
 
 
 @pytest.mark.parametrize("bones", [2, 4, 8, 12, 16, 24, 32, 48, 64])
