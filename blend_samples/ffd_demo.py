@@ -12,7 +12,6 @@ import os
 
 import bpy
 import numpy as np
-
 from kodawari import bulk, fcurves, native
 
 OUT = os.environ.get("KODAWARI_OUT", os.path.join(os.getcwd(), "out"))
@@ -40,7 +39,9 @@ def body_mesh(name, rings=140, around=48):
     for r in range(rings - 1):
         for a in range(around):
             b = (a + 1) % around
-            faces.append((r * around + a, r * around + b, (r + 1) * around + b, (r + 1) * around + a))
+            faces.append(
+                (r * around + a, r * around + b, (r + 1) * around + b, (r + 1) * around + a)
+            )
     mesh = bpy.data.meshes.new(name)
     mesh.from_pydata(co.reshape(-1, 3).tolist(), [], faces)
     mesh.update()
@@ -99,7 +100,9 @@ def axis_curve(name, frames_points):
     for i, point in enumerate(spline.points):
         values = np.column_stack([frames_points[:, i, :], np.ones(FRAMES)])
         point.co = values[0]
-        fcurves.write_channels(action, curve, f"splines[0].points[{i}].co", frames, values, group="axis")
+        fcurves.write_channels(
+            action, curve, f"splines[0].points[{i}].co", frames, values, group="axis"
+        )
     obj = bpy.data.objects.new(name, curve)
     obj.location.z = 0.45
     obj.visible_shadow = False
@@ -118,7 +121,9 @@ def bake_shape_keys(obj, binding, frames_points):
         block = obj.shape_key_add(name=f"ffd_{frame:03d}", from_mix=False)
         bulk.set_shape_key_positions(block, out)
         frames = np.array([frame - 1, frame, frame + 1], np.float64)
-        fcurve = fcurves.ensure_fcurve(action, key, f'key_blocks["{block.name}"].value', group="ffd")
+        fcurve = fcurves.ensure_fcurve(
+            action, key, f'key_blocks["{block.name}"].value', group="ffd"
+        )
         fcurves.write_keys(fcurve, frames, np.array([0.0, 1.0, 0.0]))
 
 
@@ -132,16 +137,22 @@ def build_scene(kn):
     scene.collection.objects.link(body)
     mesh.materials.append(striped_material())
 
-    rest = np.column_stack([np.linspace(HEAD_X, AXIS_END_X, AXIS_POINTS), np.zeros(AXIS_POINTS), np.zeros(AXIS_POINTS)])
+    rest = np.column_stack(
+        [np.linspace(HEAD_X, AXIS_END_X, AXIS_POINTS), np.zeros(AXIS_POINTS), np.zeros(AXIS_POINTS)]
+    )
     rest_lengths = np.linalg.norm(np.diff(rest, axis=0), axis=1)
     rest_arc = kn.curve_length(rest)
     binding = kn.ffd_bind(rest, bulk.vertex_positions(mesh))
-    frames_points = np.stack([swim_axis(f, rest, rest_lengths, rest_arc, kn) for f in range(1, FRAMES + 1)])
+    frames_points = np.stack(
+        [swim_axis(f, rest, rest_lengths, rest_arc, kn) for f in range(1, FRAMES + 1)]
+    )
     bake_shape_keys(body, binding, frames_points)
     scene.collection.objects.link(axis_curve("ffd_axis", frames_points))
 
     floor = bpy.data.meshes.new("floor")
-    floor.from_pydata([(-6, -6, -0.6), (6, -6, -0.6), (6, 6, -0.6), (-6, 6, -0.6)], [], [(0, 1, 2, 3)])
+    floor.from_pydata(
+        [(-6, -6, -0.6), (6, -6, -0.6), (6, 6, -0.6), (-6, 6, -0.6)], [], [(0, 1, 2, 3)]
+    )
     floor_obj = bpy.data.objects.new("floor", floor)
     floor.materials.append(material("sand", (0.75, 0.7, 0.6), roughness=0.9))
     scene.collection.objects.link(floor_obj)
@@ -196,7 +207,9 @@ def render_sheet(scene, label, path):
         os.remove(tile_path)
         row, col = divmod(index, 2)
         # Blender images start at the bottom row: the first tiles go to the top half.
-        sheet[(1 - row) * height:(2 - row) * height, col * width:(col + 1) * width] = pixels.reshape(height, width, 4)
+        sheet[(1 - row) * height : (2 - row) * height, col * width : (col + 1) * width] = (
+            pixels.reshape(height, width, 4)
+        )
     image = bpy.data.images.new("ffd_demo_sheet", 2 * width, 2 * height, alpha=True)
     image.pixels.foreach_set(sheet.reshape(-1))
     image.filepath_raw = path

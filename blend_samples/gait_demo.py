@@ -39,7 +39,9 @@ def build_scene():
     scene.frame_start, scene.frame_end = 1, 30 * FPS
 
     ground = bpy.data.objects.new("Ground", bpy.data.meshes.new("Ground"))
-    ground.data.from_pydata([(-30, -400, 0), (30, -400, 0), (30, 30, 0), (-30, 30, 0)], [], [(0, 1, 2, 3)])
+    ground.data.from_pydata(
+        [(-30, -400, 0), (30, -400, 0), (30, 30, 0), (-30, 30, 0)], [], [(0, 1, 2, 3)]
+    )
     ground.data.materials.append(material("Turf", (0.32, 0.42, 0.22, 1)))
     scene.collection.objects.link(ground)
 
@@ -70,7 +72,11 @@ def build_scene():
     scene.collection.objects.link(sun)
     camera = bpy.data.objects.new("Camera", bpy.data.cameras.new("Camera"))
     camera.data.lens = 35
-    camera.rotation_euler = (math.radians(88), 0, math.radians(90))  # looks along -X: runs to the left
+    camera.rotation_euler = (
+        math.radians(88),
+        0,
+        math.radians(90),
+    )  # looks along -X: runs to the left
     scene.collection.objects.link(camera)
     scene.camera = camera
     return scene, horse, dog
@@ -124,30 +130,49 @@ def rigify_scene():
     scene = bpy.context.scene
     scene.render.fps, scene.render.fps_base = FPS, 1.0
     ground = bpy.data.objects.new("Ground", bpy.data.meshes.new("Ground"))
-    ground.data.from_pydata([(-20, -300, 0), (20, -300, 0), (20, 20, 0), (-20, 20, 0)], [], [(0, 1, 2, 3)])
+    ground.data.from_pydata(
+        [(-20, -300, 0), (20, -300, 0), (20, 20, 0), (-20, 20, 0)], [], [(0, 1, 2, 3)]
+    )
     turf = material("Turf", (0.32, 0.42, 0.22, 1))
     turf.diffuse_color = (0.32, 0.42, 0.22, 1)
     ground.data.materials.append(turf)
     scene.collection.objects.link(ground)
     animals = []
-    for name, x, color, radius in (("wolf", 0.0, (0.35, 0.33, 0.3, 1), 0.14), ("horse", -3.0, (0.12, 0.045, 0.018, 1),
-                                                                                  0.3)):
+    for name, x, color, radius in (
+        ("wolf", 0.0, (0.35, 0.33, 0.3, 1), 0.14),
+        ("horse", -3.0, (0.12, 0.045, 0.018, 1), 0.3),
+    ):
         rig = samples.rigify_metarig(scene, name)
         rig.location.x = x
         bpy.context.view_layer.objects.active = rig
         bpy.ops.kodawari.gait_setup()
         s = rig.kodawari_gait
         legs = {b.name for leg in s.legs for b in leg.bones}
-        trunk = {b.name for b in rig.data.bones if b.name.split(".")[0] in ("spine", "shoulder", "thigh")}
+        trunk = {
+            b.name for b in rig.data.bones if b.name.split(".")[0] in ("spine", "shoulder", "thigh")
+        }
         body = samples.skin_armature(rig, scene, legs | trunk, radius)
         coat = material(name.capitalize(), color)
         coat.diffuse_color = color  # what Workbench shows
         body.data.materials.append(coat)
         top = {e.name: e.speed_max for e in s.table}
-        walk, trot, gallop = 0.7 * top["WALK"], 0.5 * (top["WALK"] + top["TROT"]), 0.5 * (top["CANTER"] + top["GALLOP"])
+        walk, trot, gallop = (
+            0.7 * top["WALK"],
+            0.5 * (top["WALK"] + top["TROT"]),
+            0.5 * (top["CANTER"] + top["GALLOP"]),
+        )
         s.acceleration = 6.0
-        samples.key_speed(rig, [(1, walk), (3 * FPS, walk), (4 * FPS, trot), (7 * FPS, trot), (9 * FPS, gallop),
-                                (12 * FPS, gallop)])
+        samples.key_speed(
+            rig,
+            [
+                (1, walk),
+                (3 * FPS, walk),
+                (4 * FPS, trot),
+                (7 * FPS, trot),
+                (9 * FPS, gallop),
+                (12 * FPS, gallop),
+            ],
+        )
         bpy.ops.kodawari.gait_bake(frame_start=1, frame_end=12 * FPS)
         animals.append((rig, name))
     world = bpy.data.worlds.new("Sky")
@@ -228,10 +253,24 @@ def rigify_demo():
     import subprocess
 
     if shutil.which("ffmpeg"):
-        subprocess.run(["ffmpeg", "-y", "-loglevel", "error", "-framerate", "12", "-i",
-                        os.path.join(frames_dir, "%04d.png"), "-vf",
-                        "split[a][b];[a]palettegen[p];[b][p]paletteuse", "-loop", "0",
-                        os.path.join(OUT, "rigify_gaits.gif")], check=True)
+        subprocess.run(
+            [
+                "ffmpeg",
+                "-y",
+                "-loglevel",
+                "error",
+                "-framerate",
+                "12",
+                "-i",
+                os.path.join(frames_dir, "%04d.png"),
+                "-vf",
+                "split[a][b];[a]palettegen[p];[b][p]paletteuse",
+                "-loop",
+                "0",
+                os.path.join(OUT, "rigify_gaits.gif"),
+            ],
+            check=True,
+        )
     shutil.rmtree(frames_dir)
     print("  wrote", os.path.join(OUT, "rigify_gaits.png"), "and rigify_gaits.gif")
 
@@ -264,8 +303,14 @@ def main():
     t = time.perf_counter()
     render_tiles(scene, shots)
     print(f"  rendered {len(shots)} tiles in {time.perf_counter() - t:.1f} s")
-    for name in ("horse.blend", "horse_gaits.png", "horse_gait_report.png", "horse_gait_report.json",
-                 "dog_gait_report.png", "dog_gait_report.json"):
+    for name in (
+        "horse.blend",
+        "horse_gaits.png",
+        "horse_gait_report.png",
+        "horse_gait_report.json",
+        "dog_gait_report.png",
+        "dog_gait_report.json",
+    ):
         print("  wrote", os.path.join(OUT, name))
 
 

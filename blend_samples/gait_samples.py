@@ -8,8 +8,18 @@ import bpy
 import numpy as np
 
 # (length m, absolute rest angle from straight down in degrees; positive = tip backward)
-HORSE_FORE = (("scapula", 0.45, -35.0), ("humerus", 0.30, 45.0), ("radius", 0.40, -5.0), ("cannon", 0.45, 10.0))
-HORSE_HIND = (("pelvis", 0.40, 60.0), ("femur", 0.42, -25.0), ("tibia", 0.40, 35.0), ("cannon", 0.50, -5.0))
+HORSE_FORE = (
+    ("scapula", 0.45, -35.0),
+    ("humerus", 0.30, 45.0),
+    ("radius", 0.40, -5.0),
+    ("cannon", 0.45, 10.0),
+)
+HORSE_HIND = (
+    ("pelvis", 0.40, 60.0),
+    ("femur", 0.42, -25.0),
+    ("tibia", 0.40, 35.0),
+    ("cannon", 0.50, -5.0),
+)
 DOG_FRONT = (("upper", 0.18, 35.0), ("lower", 0.18, -5.0), ("paw", 0.12, 15.0))
 DOG_BACK = (("thigh", 0.20, -30.0), ("shin", 0.20, 40.0), ("paw", 0.14, -10.0))
 
@@ -18,9 +28,24 @@ DOG_TABLE = {
     "WALK": dict(duty_factor=0.65, swing_time=0.25, swing_height=0.05, bob=0.01, speed_max=0.9),
     "TROT": dict(duty_factor=0.45, swing_time=0.22, swing_height=0.07, bob=0.015, speed_max=2.4),
     "CANTER": dict(duty_factor=0.35, swing_time=0.22, swing_height=0.08, bob=0.02, speed_max=3.6),
-    "GALLOP": dict(duty_factor=0.25, swing_time=0.2, swing_height=0.08, bob=0.02, speed_max=7.0, use_in_auto=False),
-    "GALLOP_ROTARY": dict(duty_factor=0.22, swing_time=0.2, swing_height=0.08, bob=0.02, speed_max=7.0,
-                          phase_fore_hind=0.4, phase_left_right=0.1, use_in_auto=True),
+    "GALLOP": dict(
+        duty_factor=0.25,
+        swing_time=0.2,
+        swing_height=0.08,
+        bob=0.02,
+        speed_max=7.0,
+        use_in_auto=False,
+    ),
+    "GALLOP_ROTARY": dict(
+        duty_factor=0.22,
+        swing_time=0.2,
+        swing_height=0.08,
+        bob=0.02,
+        speed_max=7.0,
+        phase_fore_hind=0.4,
+        phase_left_right=0.1,
+        use_in_auto=True,
+    ),
 }
 
 
@@ -36,8 +61,9 @@ def _leg_points(root, bones):
     return points
 
 
-def build_rig(name, scene, fore, hind, fore_y, hind_y, fore_x, hind_x, body_z, names, skin_radii,
-              extra=()):
+def build_rig(
+    name, scene, fore, hind, fore_y, hind_y, fore_x, hind_x, body_z, names, skin_radii, extra=()
+):
     """Armature + skinned mesh. names: (fore word, hind word, side format, body name)."""
     fore_word, hind_word, side_format, body_name = names
     armature = bpy.data.armatures.new(name)
@@ -58,8 +84,10 @@ def build_rig(name, scene, fore, hind, fore_y, hind_y, fore_x, hind_x, body_z, n
         skeleton["radii"].append(radius)
         return len(skeleton["verts"]) - 1
 
-    spine = [add_vertex((0.0, y, body_z + 0.05), body_name, skin_radii[0])
-             for y in np.linspace(hind_y * 1.25, fore_y * 1.3, 6)]
+    spine = [
+        add_vertex((0.0, y, body_z + 0.05), body_name, skin_radii[0])
+        for y in np.linspace(hind_y * 1.25, fore_y * 1.3, 6)
+    ]
     for a, b in zip(spine[:-1], spine[1:]):
         skeleton["edges"].append((a, b))
     tails = {}
@@ -74,7 +102,10 @@ def build_rig(name, scene, fore, hind, fore_y, hind_y, fore_x, hind_x, body_z, n
         tails[bone_name] = v1
         skeleton["edges"].append((v0, v1))
     for side, sign in (("L", 1.0), ("R", -1.0)):
-        for word, bones, y, x in ((fore_word, fore, fore_y, fore_x), (hind_word, hind, hind_y, hind_x)):
+        for word, bones, y, x in (
+            (fore_word, fore, fore_y, fore_x),
+            (hind_word, hind, hind_y, hind_x),
+        ):
             root = (sign * x, y, _drop(bones))
             points = _leg_points(root, bones)
             parent = body
@@ -120,28 +151,56 @@ def build_rig(name, scene, fore, hind, fore_y, hind_y, fore_x, hind_x, body_z, n
 
 def build_horse(scene, name="Horse"):
     """A Thoroughbred: withers ~1.5 m, 4 bones per leg named fore_*.L / hind_*.R."""
-    extra = (("neck", (0.0, -0.66, 1.5), (0.0, -1.05, 1.95), 0.14, 5),
-             ("head", (0.0, -1.05, 1.95), (0.0, -1.5, 1.62), 0.1, "neck"),
-             ("tail", (0.0, 0.7, 1.45), (0.0, 1.05, 1.05), 0.05, 0))
-    rig, body = build_rig(name, scene, HORSE_FORE, HORSE_HIND, -0.55, 0.55, 0.12, 0.14, 1.45,
-                          ("fore", "hind", ".{}", "body"), (0.32, 0.085, 0.045), extra)
+    extra = (
+        ("neck", (0.0, -0.66, 1.5), (0.0, -1.05, 1.95), 0.14, 5),
+        ("head", (0.0, -1.05, 1.95), (0.0, -1.5, 1.62), 0.1, "neck"),
+        ("tail", (0.0, 0.7, 1.45), (0.0, 1.05, 1.05), 0.05, 0),
+    )
+    rig, body = build_rig(
+        name,
+        scene,
+        HORSE_FORE,
+        HORSE_HIND,
+        -0.55,
+        0.55,
+        0.12,
+        0.14,
+        1.45,
+        ("fore", "hind", ".{}", "body"),
+        (0.32, 0.085, 0.045),
+        extra,
+    )
     return rig, body
 
 
 def build_dog(scene, name="Dog"):
     """A small dog: 3 bones per leg named front_*_L / back_*_R (other naming on purpose)."""
-    extra = (("neck", (0.0, -0.25, 0.55), (0.0, -0.38, 0.72), 0.06, 5),
-             ("head", (0.0, -0.38, 0.72), (0.0, -0.55, 0.66), 0.05, "neck"),
-             ("tail", (0.0, 0.28, 0.52), (0.0, 0.5, 0.6), 0.02, 0))
-    return build_rig(name, scene, DOG_FRONT, DOG_BACK, -0.22, 0.22, 0.07, 0.07, 0.55,
-                     ("front", "back", "_{}", "spine"), (0.12, 0.035, 0.02), extra)
+    extra = (
+        ("neck", (0.0, -0.25, 0.55), (0.0, -0.38, 0.72), 0.06, 5),
+        ("head", (0.0, -0.38, 0.72), (0.0, -0.55, 0.66), 0.05, "neck"),
+        ("tail", (0.0, 0.28, 0.52), (0.0, 0.5, 0.6), 0.02, 0),
+    )
+    return build_rig(
+        name,
+        scene,
+        DOG_FRONT,
+        DOG_BACK,
+        -0.22,
+        0.22,
+        0.07,
+        0.07,
+        0.55,
+        ("front", "back", "_{}", "spine"),
+        (0.12, 0.035, 0.02),
+        extra,
+    )
 
 
 def apply_dog_table(settings):
     for entry in settings.table:
         for key, value in DOG_TABLE.get(entry.name, {}).items():
             setattr(entry, key, value)
-        entry.froude_max = entry.speed_max ** 2 / (9.81 * 0.45)
+        entry.froude_max = entry.speed_max**2 / (9.81 * 0.45)
 
 
 def key_speed(obj, frames_and_speeds):
@@ -194,8 +253,12 @@ def skin_armature(rig, scene, bone_names, radius):
     lowest = min(b.tail_local.z for b in wanted)
     highest = max(b.head_local.z for b in wanted)
     for b in wanted:
+
         def r_at(z):
-            return radius * (0.3 + 0.7 * min(1.0, max(0.0, (z - lowest) / max(highest - lowest, 1e-6))) ** 2)
+            return radius * (
+                0.3 + 0.7 * min(1.0, max(0.0, (z - lowest) / max(highest - lowest, 1e-6))) ** 2
+            )
+
         a = vertex(b.head_local, b.name, r_at(b.head_local.z))
         c = vertex(b.tail_local, b.name, r_at(b.tail_local.z))
         if a != c:

@@ -37,8 +37,13 @@ def fish():
 def hair():
     from hair_rig import add_camera, make_rig, select_only
 
-    rig = make_rig(bpy.context.scene, chains=(("Ahoge", (0.0, 0.0, 1.8), (0.0, 0.0, 1.0), 5),
-                                              ("Tail", (0.0, 0.2, 1.0), (0.0, 1.0, -0.3), 6)))
+    rig = make_rig(
+        bpy.context.scene,
+        chains=(
+            ("Ahoge", (0.0, 0.0, 1.8), (0.0, 0.0, 1.0), 5),
+            ("Tail", (0.0, 0.2, 1.0), (0.0, 1.0, -0.3), 6),
+        ),
+    )
     add_camera(bpy.context.scene, "Front", (0.0, -3.0, 1.7))
     select_only(rig, {"Ahoge.00", "Tail.00"})
     bpy.ops.kodawari.rod_add()
@@ -57,8 +62,12 @@ def gait():
     return "OBJECT", "Kodawari Gait"
 
 
-SHOTS = (("fish_panel", fish, "en_US"), ("hair_panel", hair, "en_US"), ("gait_panel", gait, "en_US"),
-         ("fish_panel_ja", fish, "ja_JP"))
+SHOTS = (
+    ("fish_panel", fish, "en_US"),
+    ("hair_panel", hair, "en_US"),
+    ("gait_panel", gait, "en_US"),
+    ("fish_panel_ja", fish, "ja_JP"),
+)
 
 
 def _properties_area(window):
@@ -107,7 +116,7 @@ def drive():
         return next(state["runner"])
     except StopIteration:
         code = 0
-    except Exception:  # noqa: BLE001 - reported, then Blender exits non-zero
+    except Exception:
         traceback.print_exc()
         code = 1
     sys.stdout.flush()

@@ -29,10 +29,13 @@ def main(argv):
         print(json.dumps(msgid, ensure_ascii=False))
     print(f"{len(missing)} string(s) without a {locale} translation", file=sys.stderr)
     for msgid in translations.unused(locale):
-        print(f"unused entry (safe to delete): {json.dumps(msgid, ensure_ascii=False)}", file=sys.stderr)
+        print(
+            f"unused entry (safe to delete): {json.dumps(msgid, ensure_ascii=False)}",
+            file=sys.stderr,
+        )
     return 1 if missing else 0
 
 
 if __name__ == "__main__":
-    args = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else sys.argv[1:]
+    args = sys.argv[sys.argv.index("--") + 1 :] if "--" in sys.argv else sys.argv[1:]
     sys.exit(main(args))

@@ -14,7 +14,9 @@ TARGET = os.path.join(ROOT, "dist", "kodawari.zip")
 
 def main():
     if not glob.glob(os.path.join(SOURCE, "kodawari_native*.so")):
-        sys.exit("make_addon_zip: addon/kodawari has no compiled kodawari_native; run `make native` first")
+        sys.exit(
+            "make_addon_zip: addon/kodawari has no compiled kodawari_native; run `make native` first"
+        )
     os.makedirs(os.path.dirname(TARGET), exist_ok=True)
     count = 0
     with zipfile.ZipFile(TARGET, "w", zipfile.ZIP_DEFLATED) as archive:

@@ -59,7 +59,9 @@ def _jobs(scene, context):
         if obj.type == "ARMATURE" and _gait_ready(obj):
             yield obj.name, lambda obj=obj: GaitBakeJob(context, obj, start, end)
     for obj in objects:
-        if obj.type == "MESH" and fish_visibility.renders(obj):  # what the render shows, not the viewport
+        if obj.type == "MESH" and fish_visibility.renders(
+            obj
+        ):  # what the render shows, not the viewport
             yield (
                 obj.name,
                 lambda obj=obj: fish_bake.SwimBakeJob(obj, scene, start, end, "MESH_CACHE"),

@@ -88,7 +88,9 @@ def write_keys(fcurve, frames, values, interpolation="LINEAR"):
     co[0::2] = frames
     co[1::2] = values
     points.foreach_set("co", co)
-    interp_enum = bpy.types.Keyframe.bl_rna.properties["interpolation"].enum_items[interpolation].value
+    interp_enum = (
+        bpy.types.Keyframe.bl_rna.properties["interpolation"].enum_items[interpolation].value
+    )
     points.foreach_set("interpolation", np.full(n, interp_enum, dtype=np.int32))
     fcurve.update()
 
@@ -159,8 +161,12 @@ def copy_keys(fcurve):
     its extrapolation, read in bulk, for copy_into."""
     points = fcurve.keyframe_points
     n = len(points)
-    data = {"data_path": fcurve.data_path, "index": fcurve.array_index,
-            "group": fcurve.group.name if fcurve.group else "", "extrapolation": fcurve.extrapolation}
+    data = {
+        "data_path": fcurve.data_path,
+        "index": fcurve.array_index,
+        "group": fcurve.group.name if fcurve.group else "",
+        "extrapolation": fcurve.extrapolation,
+    }
     for name in _KEY_VECTORS:
         data[name] = np.empty(2 * n, dtype=np.float32)
         points.foreach_get(name, data[name])

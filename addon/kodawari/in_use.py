@@ -12,7 +12,11 @@ def swim(obj):
 
 
 def hair(obj):
-    return obj is not None and obj.type == "ARMATURE" and bool(obj.kodawari_hair.rods or obj.kodawari_hair.colliders)
+    return (
+        obj is not None
+        and obj.type == "ARMATURE"
+        and bool(obj.kodawari_hair.rods or obj.kodawari_hair.colliders)
+    )
 
 
 def gait(obj):
@@ -38,14 +42,18 @@ def add_panel(idname, label, tab, can_use, uses, operator, text, icon):
     def draw(self, context):
         self.layout.operator(operator, text=text, icon=icon)
 
-    return type(idname, (bpy.types.Panel,), {
-        "__doc__": f'On an object that could use it: one "{text}" button.',
-        "bl_idname": idname,
-        "bl_label": label,
-        "bl_space_type": "PROPERTIES",
-        "bl_region_type": "WINDOW",
-        "bl_context": tab,
-        "bl_options": {"HIDE_HEADER"},
-        "poll": classmethod(poll),
-        "draw": draw,
-    })
+    return type(
+        idname,
+        (bpy.types.Panel,),
+        {
+            "__doc__": f'On an object that could use it: one "{text}" button.',
+            "bl_idname": idname,
+            "bl_label": label,
+            "bl_space_type": "PROPERTIES",
+            "bl_region_type": "WINDOW",
+            "bl_context": tab,
+            "bl_options": {"HIDE_HEADER"},
+            "poll": classmethod(poll),
+            "draw": draw,
+        },
+    )

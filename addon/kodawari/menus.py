@@ -20,7 +20,12 @@ SWIM_ITEMS = (
     ("kodawari.swim_flip_head", "ARROW_LEFTRIGHT", None, {}),
     None,
     ("kodawari.swim_bake", "FILE_CACHE", "Bake Fish Swim to Mesh Cache", {"target": "MESH_CACHE"}),
-    ("kodawari.swim_bake", "SHAPEKEY_DATA", "Bake Fish Swim to Shape Keys", {"target": "SHAPE_KEYS"}),
+    (
+        "kodawari.swim_bake",
+        "SHAPEKEY_DATA",
+        "Bake Fish Swim to Shape Keys",
+        {"target": "SHAPE_KEYS"},
+    ),
     ("kodawari.swim_apply", "CHECKMARK", None, {}),
     ("kodawari.swim_remove", "X", None, {}),
 )
@@ -55,7 +60,9 @@ def _registered_operators():
     found = {}
     for cls in registration.registered_classes():
         idname = getattr(cls, "bl_idname", "")
-        if issubclass(cls, bpy.types.Operator) and "INTERNAL" not in getattr(cls, "bl_options", set()):
+        if issubclass(cls, bpy.types.Operator) and "INTERNAL" not in getattr(
+            cls, "bl_options", set()
+        ):
             found[idname] = cls
     return found
 
@@ -71,10 +78,16 @@ def _draw_items(layout, items, prefix):
         if idname not in operators:
             continue  # not in this build
         listed.add(idname)
-        op = layout.operator(idname, icon=icon) if text is None else layout.operator(idname, text=text, icon=icon)
+        op = (
+            layout.operator(idname, icon=icon)
+            if text is None
+            else layout.operator(idname, text=text, icon=icon)
+        )
         for name, value in values.items():
             setattr(op, name, value)
-    extra = sorted(name for name in operators if name.split(".")[1].startswith(prefix) and name not in listed)
+    extra = sorted(
+        name for name in operators if name.split(".")[1].startswith(prefix) and name not in listed
+    )
     if extra:
         layout.separator()
         for idname in extra:
@@ -114,7 +127,9 @@ class KODAWARI_MT_hair_key_add(bpy.types.Menu):
     def draw(self, context):
         layout = self.layout
         layout.operator("kodawari.rod_key_view", text="View", icon="CAMERA_DATA").source = "CAMERA"
-        layout.operator("kodawari.rod_key_view", text="View (Viewport)", icon="VIEW3D").source = "VIEWPORT"
+        layout.operator(
+            "kodawari.rod_key_view", text="View (Viewport)", icon="VIEW3D"
+        ).source = "VIEWPORT"
         layout.operator("kodawari.rod_key_pose", text="Pose", icon="ARMATURE_DATA")
         layout.operator("kodawari.rod_key_speed", text="Speed", icon="FORCE_WIND")
 
@@ -133,8 +148,11 @@ class KODAWARI_MT_main(bpy.types.Menu):
         layout.menu("KODAWARI_MT_hair", icon="STRANDS")
         layout.menu("KODAWARI_MT_gait", icon="ANIM")
         # Anything registered outside the three features (e.g. whole-file tools).
-        others = sorted(name for name in _registered_operators()
-                        if not name.split(".")[1].startswith(_covered_prefixes()))
+        others = sorted(
+            name
+            for name in _registered_operators()
+            if not name.split(".")[1].startswith(_covered_prefixes())
+        )
         if others:
             layout.separator()
             for idname in others:
@@ -166,8 +184,14 @@ def draw_modifier_deform(self, context):
         self.layout.operator("kodawari.swim_add", text="Fish Swim", icon="MOD_WAVE")
 
 
-CLASSES = (KODAWARI_MT_swim, KODAWARI_MT_hair, KODAWARI_MT_gait, KODAWARI_MT_hair_key_add, KODAWARI_MT_main,
-           KODAWARI_MT_pose)
+CLASSES = (
+    KODAWARI_MT_swim,
+    KODAWARI_MT_hair,
+    KODAWARI_MT_gait,
+    KODAWARI_MT_hair_key_add,
+    KODAWARI_MT_main,
+    KODAWARI_MT_pose,
+)
 
 # (menu class name, draw function): the menu exists in every supported Blender except the
 # Deform submenu of Add Modifier, which Blender 4.0 introduced (3.4's Add Modifier is not Python).

@@ -23,11 +23,15 @@ def _diagnose(exc):
     builds = sorted(os.path.basename(p) for p in glob.glob(os.path.join(here, "kodawari_native*")))
     want = f"Python {sys.version_info[0]}.{sys.version_info[1]} ({_expected_tag()})"
     if not builds:
-        return (f"Kodawari's compiled core (kodawari_native) is not in this package. "
-                f"Install a dist/kodawari.zip built with `make addon` for {want}.")
+        return (
+            f"Kodawari's compiled core (kodawari_native) is not in this package. "
+            f"Install a dist/kodawari.zip built with `make addon` for {want}."
+        )
     if not any(_expected_tag() in b for b in builds):
-        return (f"Kodawari's compiled core was built for another Python: found {', '.join(builds)}, "
-                f"this Blender runs {want}. Rebuild with `make addon` for {want}.")
+        return (
+            f"Kodawari's compiled core was built for another Python: found {', '.join(builds)}, "
+            f"this Blender runs {want}. Rebuild with `make addon` for {want}."
+        )
     return f"Kodawari's compiled core failed to load ({', '.join(builds)}): {exc}"
 
 
@@ -45,8 +49,10 @@ def load():
         _error = _diagnose(exc)
         return None
     if getattr(module, "__version__", None) != ADDON_VERSION:
-        _error = (f"Kodawari's compiled core is version {getattr(module, '__version__', '?')}, "
-                  f"the add-on is {ADDON_VERSION}: install a matching build (`make addon`).")
+        _error = (
+            f"Kodawari's compiled core is version {getattr(module, '__version__', '?')}, "
+            f"the add-on is {ADDON_VERSION}: install a matching build (`make addon`)."
+        )
         return None
     _module = module
     return _module

@@ -14,20 +14,29 @@ class KodawariPreferences(bpy.types.AddonPreferences):
     bl_idname = __package__
 
     hair_cache_megabytes: bpy.props.IntProperty(
-        name="Hair Cache Budget", default=256, min=16, soft_max=8192, subtype="NONE",
+        name="Hair Cache Budget",
+        default=256,
+        min=16,
+        soft_max=8192,
+        subtype="NONE",
         description="Memory (MB) the live hair frame cache of each armature may use; beyond it only "
-                    "checkpoints are kept and scrubbing back re-simulates from the nearest one")
+        "checkpoints are kept and scrubbing back re-simulates from the nearest one",
+    )
 
     def draw(self, context):
         layout = self.layout
         layout.prop(self, "hair_cache_megabytes")
         if native.available():
             mod = native.module()
-            layout.label(text=f"Compiled core loaded: kodawari_native {mod.__version__}", icon="CHECKMARK")
+            layout.label(
+                text=f"Compiled core loaded: kodawari_native {mod.__version__}", icon="CHECKMARK"
+            )
         else:
             box = layout.box()
             box.alert = True
-            box.label(text="Kodawari's compiled core did not load; its tools are disabled.", icon="ERROR")
+            box.label(
+                text="Kodawari's compiled core did not load; its tools are disabled.", icon="ERROR"
+            )
             for line in _wrap(native.error() or "", 90):
                 box.label(text=line)
 

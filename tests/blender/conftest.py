@@ -14,7 +14,7 @@ ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 sys.path.insert(0, os.path.join(ROOT, "tools"))
-from blender_install_addon import ADDON_ZIP, install_addon  # noqa: E402
+from blender_install_addon import ADDON_ZIP, install_addon
 
 
 @pytest.fixture(scope="session", autouse=True)

@@ -6,7 +6,9 @@ import sys
 import bpy
 
 # The sample rig builders live with the demos (blend_samples/), not in the add-on.
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "blend_samples"))
+sys.path.insert(
+    0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "blend_samples")
+)
 
 
 def horse(scene, speeds=None, fps=24):
@@ -29,8 +31,10 @@ def fcurve_snapshot(obj):
     anim = obj.animation_data
     if anim is None or anim.action is None:
         return {}
-    return {(c.data_path, c.array_index): fcurves.read_keys(c)[1].tolist()
-            for c in fcurves.action_fcurves(anim.action, obj)}
+    return {
+        (c.data_path, c.array_index): fcurves.read_keys(c)[1].tolist()
+        for c in fcurves.action_fcurves(anim.action, obj)
+    }
 
 
 # --- rigs nobody on the project made --------------------------------------------------
@@ -70,19 +74,43 @@ def _rescale(obj, scale):
 # Naming conventions of rigs users bring: (body bones hips..spine2, neck, head),
 # fore (girdle, upper, lower, paw), hind (upper, lower, foot, toe); {s}/{S}/{Side} = side.
 CONVENTIONS = {
-    "mixamo": (("mixamorig:Hips", "mixamorig:Spine", "mixamorig:Spine1", "mixamorig:Spine2", "mixamorig:Neck",
-                "mixamorig:Head"),
-               ("mixamorig:{Side}Shoulder", "mixamorig:{Side}Arm", "mixamorig:{Side}ForeArm", "mixamorig:{Side}Hand"),
-               ("mixamorig:{Side}UpLeg", "mixamorig:{Side}Leg", "mixamorig:{Side}Foot", "mixamorig:{Side}ToeBase")),
-    "unreal": (("pelvis", "spine_01", "spine_02", "spine_03", "neck_01", "head"),
-               ("clavicle_{s}", "upperarm_{s}", "lowerarm_{s}", "hand_{s}"),
-               ("thigh_{s}", "calf_{s}", "foot_{s}", "ball_{s}")),
-    "max_biped": (("Bip01 Pelvis", "Bip01 Spine", "Bip01 Spine1", "Bip01 Spine2", "Bip01 Neck", "Bip01 Head"),
-                  ("Bip01 {S} Clavicle", "Bip01 {S} UpperArm", "Bip01 {S} Forearm", "Bip01 {S} Hand"),
-                  ("Bip01 {S} Thigh", "Bip01 {S} Calf", "Bip01 {S} Foot", "Bip01 {S} Toe0")),
-    "game": (("b_Hips_01", "b_Spine_02", "b_Spine1_03", "b_Spine2_04", "b_Neck_05", "b_Head_06"),
-             ("b_{Side}Shoulder_07", "b_{Side}UpperArm_09", "b_{Side}ForeArm_10", "b_{Side}Hand_11"),
-             ("b_{Side}Leg01_20", "b_{Side}Leg02_21", "b_{Side}Foot_22", "b_{Side}Toe_23")),
+    "mixamo": (
+        (
+            "mixamorig:Hips",
+            "mixamorig:Spine",
+            "mixamorig:Spine1",
+            "mixamorig:Spine2",
+            "mixamorig:Neck",
+            "mixamorig:Head",
+        ),
+        (
+            "mixamorig:{Side}Shoulder",
+            "mixamorig:{Side}Arm",
+            "mixamorig:{Side}ForeArm",
+            "mixamorig:{Side}Hand",
+        ),
+        (
+            "mixamorig:{Side}UpLeg",
+            "mixamorig:{Side}Leg",
+            "mixamorig:{Side}Foot",
+            "mixamorig:{Side}ToeBase",
+        ),
+    ),
+    "unreal": (
+        ("pelvis", "spine_01", "spine_02", "spine_03", "neck_01", "head"),
+        ("clavicle_{s}", "upperarm_{s}", "lowerarm_{s}", "hand_{s}"),
+        ("thigh_{s}", "calf_{s}", "foot_{s}", "ball_{s}"),
+    ),
+    "max_biped": (
+        ("Bip01 Pelvis", "Bip01 Spine", "Bip01 Spine1", "Bip01 Spine2", "Bip01 Neck", "Bip01 Head"),
+        ("Bip01 {S} Clavicle", "Bip01 {S} UpperArm", "Bip01 {S} Forearm", "Bip01 {S} Hand"),
+        ("Bip01 {S} Thigh", "Bip01 {S} Calf", "Bip01 {S} Foot", "Bip01 {S} Toe0"),
+    ),
+    "game": (
+        ("b_Hips_01", "b_Spine_02", "b_Spine1_03", "b_Spine2_04", "b_Neck_05", "b_Head_06"),
+        ("b_{Side}Shoulder_07", "b_{Side}UpperArm_09", "b_{Side}ForeArm_10", "b_{Side}Hand_11"),
+        ("b_{Side}Leg01_20", "b_{Side}Leg02_21", "b_{Side}Foot_22", "b_{Side}Toe_23"),
+    ),
 }
 # A fox-sized quadruped (metres, facing -Y): legs as (length, absolute angle from
 # straight down, + = tip backward).
@@ -162,11 +190,15 @@ def expected_feet(convention):
         _, fore, hind = CONVENTIONS[convention]
         out = []
         for names, side in ((fore, "L"), (fore, "R"), (hind, "L"), (hind, "R")):
-            out.append(names[-1].format(s=side.lower(), S=side, Side="Left" if side == "L" else "Right"))
+            out.append(
+                names[-1].format(s=side.lower(), S=side, Side="Left" if side == "L" else "Right")
+            )
         return out
-    return {"wolf": ["front_toe.L", "front_toe.R", "toe.L", "toe.R"],
-            "cat": ["f_toe.L", "f_toe.R", "r_toe.L", "r_toe.R"],
-            "horse": ["f_hoof.L", "f_hoof.R", "r_hoof.L", "r_hoof.R"]}[convention]
+    return {
+        "wolf": ["front_toe.L", "front_toe.R", "toe.L", "toe.R"],
+        "cat": ["f_toe.L", "f_toe.R", "r_toe.L", "r_toe.R"],
+        "horse": ["f_hoof.L", "f_hoof.R", "r_hoof.L", "r_hoof.R"],
+    }[convention]
 
 
 def select_pose_bones(obj, names):

@@ -6,5 +6,5 @@ import sys
 
 import pytest
 
-args = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else ["tests/blender"]
+args = sys.argv[sys.argv.index("--") + 1 :] if "--" in sys.argv else ["tests/blender"]
 sys.exit(int(pytest.main(["-p", "no:cacheprovider", *args])))

@@ -5,8 +5,8 @@ import subprocess
 import sys
 import textwrap
 
+import addon_utils
 import bpy  # first: importing bpy puts Blender's own modules (addon_utils) on sys.path
-import addon_utils  # noqa: E402
 import pytest
 from conftest import ADDON_ZIP
 
@@ -49,7 +49,16 @@ def _run_isolated(script, tmp_path):
     code = textwrap.dedent(script)
     binary = bpy.app.binary_path or ""
     if os.path.basename(binary).startswith("blender"):
-        cmd = [binary, "-b", "--factory-startup", "-noaudio", "--python-exit-code", "1", "--python-expr", code]
+        cmd = [
+            binary,
+            "-b",
+            "--factory-startup",
+            "-noaudio",
+            "--python-exit-code",
+            "1",
+            "--python-expr",
+            code,
+        ]
     else:
         cmd = [sys.executable, "-c", code]
     env = dict(os.environ)
@@ -92,8 +101,10 @@ print("AFTER:", sorted(n for n in dir(bpy.types) if "KODAWARI" in n.upper()))
 
 @pytest.mark.parametrize(
     "rename_core, reason",
-    [(None, "is not in this package"),
-     ("kodawari_native.cpython-312-x86_64-linux-gnu.so", "built for another Python")],
+    [
+        (None, "is not in this package"),
+        ("kodawari_native.cpython-312-x86_64-linux-gnu.so", "built for another Python"),
+    ],
 )
 def test_missing_or_foreign_core_enables_with_a_readable_reason(tmp_path, rename_core, reason):
     repacked = _repack(tmp_path, rename_core)

@@ -132,7 +132,9 @@ def test_a_hair_bake_failing_midway_is_undone_and_not_simulated_by_the_live_hand
     monkeypatch.setattr(
         runtime,
         "evaluate_scene",
-        lambda scene, *_: live.append((scene.frame_current, [o.name for o in hair_armatures(scene)])),
+        lambda scene, *_: live.append(
+            (scene.frame_current, [o.name for o in hair_armatures(scene)])
+        ),
     )
     _fails_on_the_third_call(monkeypatch, runtime.ArmatureRuntime, "evaluate")
     _refused_cleanly(bpy.ops.kodawari.rod_bake, frame_start=1, frame_end=30)

@@ -6,8 +6,9 @@ import numpy as np
 
 
 def _tube(scene):
-    bpy.ops.mesh.primitive_cylinder_add(vertices=24, depth=4.0, radius=0.3, location=(2.0, 0.0, 0.0),
-                                        rotation=(0.0, np.pi / 2, 0.0))
+    bpy.ops.mesh.primitive_cylinder_add(
+        vertices=24, depth=4.0, radius=0.3, location=(2.0, 0.0, 0.0), rotation=(0.0, np.pi / 2, 0.0)
+    )
     obj = bpy.context.active_object
     bpy.ops.object.transform_apply(location=True, rotation=True, scale=True)
     return obj
@@ -28,8 +29,9 @@ def test_bent_positions_reach_the_evaluated_mesh_through_a_shape_key(empty_scene
 
     bent = axis.copy()
     bent[:, 1] = 0.5 * np.linspace(0, 1, 6) ** 2
-    bent = kn.preserve_lengths_from_head(bent, np.linalg.norm(np.diff(axis, axis=0), axis=1),
-                                         arc_length=kn.curve_length(axis))
+    bent = kn.preserve_lengths_from_head(
+        bent, np.linalg.norm(np.diff(axis, axis=0), axis=1), arc_length=kn.curve_length(axis)
+    )
     binding.deform(bent, out)
     obj.shape_key_add(name="Basis")
     key = obj.shape_key_add(name="kodawari_ffd")

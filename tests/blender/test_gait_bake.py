@@ -4,7 +4,6 @@ issue's "Must show"), bad input refused with nothing changed, Esc-cancel restori
 import bpy
 import numpy as np
 import pytest
-
 from gait_scene import fcurve_snapshot, horse
 
 GAITS = ("WALK", "TROT", "CANTER", "GALLOP", "GALLOP_ROTARY")
@@ -21,14 +20,16 @@ def test_bake_writes_every_channel_and_keeps_the_speed_keys(empty_scene):
         for bone in leg.bones:
             # Hinges about the bone's own X axis are one Euler channel, others a quaternion.
             euler = curves.get((f'pose.bones["{bone.name}"].rotation_euler', 0))
-            quats = [curves.get((f'pose.bones["{bone.name}"].rotation_quaternion', i)) for i in range(4)]
+            quats = [
+                curves.get((f'pose.bones["{bone.name}"].rotation_quaternion', i)) for i in range(4)
+            ]
             assert euler is not None or all(q is not None for q in quats), bone.name
             for c in [euler] if euler is not None else quats:
                 assert len(c.keyframe_points) == 60
     for i in range(3):
-        assert (f'pose.bones["body"].location', i) in curves
+        assert ('pose.bones["body"].location', i) in curves
     for i in range(4):
-        assert (f'pose.bones["body"].rotation_quaternion', i) in curves
+        assert ('pose.bones["body"].rotation_quaternion', i) in curves
     for leg in ("LF", "RF", "LH", "RH"):
         c = curves[(f'["kodawari_contact_{leg}"]', 0)]
         values = fcurves.read_keys(c)[1]
@@ -52,11 +53,19 @@ def _steady(rig, fps, seconds):
     data = measure_baked(rig, fps)
     s = rig.kodawari_gait
     keep = slice(2 * fps, None)
-    segs = metrics.measure(data["feet"][keep], data["roots"][keep], data["headings"][keep], data["contacts"][keep],
-                           data["gait"][keep], data["angles"][keep],
-                           np.radians([b.limit_min for leg in s.legs for b in leg.bones]),
-                           np.radians([b.limit_max for leg in s.legs for b in leg.bones]),
-                           rigmod.neutral_offsets(data["rig"]), data["reach"], fps)
+    segs = metrics.measure(
+        data["feet"][keep],
+        data["roots"][keep],
+        data["headings"][keep],
+        data["contacts"][keep],
+        data["gait"][keep],
+        data["angles"][keep],
+        np.radians([b.limit_min for leg in s.legs for b in leg.bones]),
+        np.radians([b.limit_max for leg in s.legs for b in leg.bones]),
+        rigmod.neutral_offsets(data["rig"]),
+        data["reach"],
+        fps,
+    )
     assert len(segs) == 1
     return segs[0]
 
@@ -81,8 +90,10 @@ def test_a_rolled_bone_is_keyed_by_quaternion_and_measures_the_same(empty_scene)
     assert np.abs(np.array(tail) - solved["feet"][29, 0]).max() < 2e-3
 
 
-@pytest.mark.parametrize("gait,speed", [("WALK", 1.2), ("TROT", 3.5), ("CANTER", 5.5), ("GALLOP", 12.0),
-                                        ("GALLOP_ROTARY", 12.0)])
+@pytest.mark.parametrize(
+    "gait,speed",
+    [("WALK", 1.2), ("TROT", 3.5), ("CANTER", 5.5), ("GALLOP", 12.0), ("GALLOP_ROTARY", 12.0)],
+)
 def test_steady_gait_measured_from_the_action_matches_the_table(empty_scene, gait, speed):
     from kodawari import native
     from kodawari.gait import rig as rigmod
@@ -102,7 +113,11 @@ def test_steady_gait_measured_from_the_action_matches_the_table(empty_scene, gai
     for k, leg in enumerate(("LF", "RF", "LH", "RH")):
         got = seg["legs"][leg]
         assert abs(got["duty_factor"] - duty) < 0.03, (leg, got["duty_factor"])
-        assert abs((got["phase"] - phases[k] + 0.5) % 1 - 0.5) < 0.03, (leg, got["phase"], phases[k])
+        assert abs((got["phase"] - phases[k] + 0.5) % 1 - 0.5) < 0.03, (
+            leg,
+            got["phase"],
+            phases[k],
+        )
         assert got["stride"] == pytest.approx(speed * entry.swing_time / (1 - duty), rel=0.01)
         assert got["largest_stance_slide"] < 0.005
 
@@ -136,25 +151,30 @@ def test_bake_is_deterministic(empty_scene):
     assert fcurve_snapshot(rig) == first
 
 
-@pytest.mark.parametrize("case,message", [
-    ("negative", "speed is negative"),
-    ("too_fast", "past the range"),
-    ("far_ground", "does not lie under"),
-    ("cliff", "out of the legs' reach"),
-    ("one_bone", "needs 2 to 6"),
-    ("no_body", "no body bone"),
-])
+@pytest.mark.parametrize(
+    "case,message",
+    [
+        ("negative", "speed is negative"),
+        ("too_fast", "past the range"),
+        ("far_ground", "does not lie under"),
+        ("cliff", "out of the legs' reach"),
+        ("one_bone", "needs 2 to 6"),
+        ("no_body", "no body bone"),
+    ],
+)
 def test_bad_input_is_refused_and_changes_nothing(empty_scene, case, message):
     rig = horse(empty_scene, [(1, 2.0), (40, 2.0)])
     bpy.ops.kodawari.gait_bake(frame_start=1, frame_end=40)  # an earlier bake to protect
     s = rig.kodawari_gait
     if case == "negative":
         import gait_samples as samples
+
         samples.key_speed(rig, [(20, -1.0)])
     elif case == "too_fast":
         s.speed = 40.0
         rig.animation_data.action = rig.animation_data.action  # keep the action
         from kodawari import fcurves
+
         action = rig.animation_data.action
         c = fcurves.find_fcurve(action, rig, "kodawari_gait.speed")
         for point in c.keyframe_points:
@@ -162,14 +182,28 @@ def test_bad_input_is_refused_and_changes_nothing(empty_scene, case, message):
         c.update()
     elif case == "far_ground":
         ground = bpy.data.objects.new("Ground", bpy.data.meshes.new("Ground"))
-        ground.data.from_pydata([(-1, -1, 0), (1, -1, 0), (1, 1, 0), (-1, 1, 0)], [], [(0, 1, 2, 3)])
+        ground.data.from_pydata(
+            [(-1, -1, 0), (1, -1, 0), (1, 1, 0), (-1, 1, 0)], [], [(0, 1, 2, 3)]
+        )
         ground.location = (500.0, 0.0, 0.0)
         empty_scene.collection.objects.link(ground)
         s.ground = ground
     elif case == "cliff":  # flat, then a 1.2 m wall up across the run
         ground = bpy.data.objects.new("Cliff", bpy.data.meshes.new("Cliff"))
-        ground.data.from_pydata([(-5, 10, 0), (5, 10, 0), (5, -3, 0), (-5, -3, 0), (-5, -3, 1.2), (5, -3, 1.2),
-                                 (5, -60, 1.2), (-5, -60, 1.2)], [], [(0, 1, 2, 3), (3, 2, 5, 4), (4, 5, 6, 7)])
+        ground.data.from_pydata(
+            [
+                (-5, 10, 0),
+                (5, 10, 0),
+                (5, -3, 0),
+                (-5, -3, 0),
+                (-5, -3, 1.2),
+                (5, -3, 1.2),
+                (5, -60, 1.2),
+                (-5, -60, 1.2),
+            ],
+            [],
+            [(0, 1, 2, 3), (3, 2, 5, 4), (4, 5, 6, 7)],
+        )
         empty_scene.collection.objects.link(ground)
         s.ground = ground
     elif case == "one_bone":
@@ -212,7 +246,7 @@ def test_cancel_puts_everything_back(empty_scene):
     assert fcurve_snapshot(rig) == before
     assert {pb.name: pb.rotation_mode for pb in rig.pose.bones} == modes
     assert not any(k.startswith("kodawari_contact_") for k in rig.keys())
-    assert len([a for a in bpy.data.actions]) == 1
+    assert len(list(bpy.data.actions)) == 1
 
 
 def test_feet_follow_a_sloped_ground(empty_scene):
@@ -222,7 +256,9 @@ def test_feet_follow_a_sloped_ground(empty_scene):
 
     rig = horse(empty_scene)
     ground = bpy.data.objects.new("Slope", bpy.data.meshes.new("Slope"))
-    ground.data.from_pydata([(-5, -60, 0), (5, -60, 0), (5, 10, 0), (-5, 10, 0)], [], [(0, 1, 2, 3)])
+    ground.data.from_pydata(
+        [(-5, -60, 0), (5, -60, 0), (5, 10, 0), (-5, 10, 0)], [], [(0, 1, 2, 3)]
+    )
     ground.rotation_euler = (math.radians(-4.0), 0.0, 0.0)  # rises towards -Y, where the horse goes
     empty_scene.collection.objects.link(ground)
     empty_scene.view_layers[0].update()

@@ -7,7 +7,6 @@ import os
 import bpy
 import numpy as np
 import pytest
-
 from gait_scene import horse
 
 RAMP = [(1, 1.5), (48, 1.5), (360, 17.0), (672, 1.5), (720, 1.5)]
@@ -22,7 +21,15 @@ def test_ramp_through_every_gait_is_smooth_and_the_report_equals_the_bake(empty_
     assert bpy.ops.kodawari.gait_report(filepath=out) == {"FINISHED"}
     report = json.load(open(str(tmp_path / "gait_report.json")))
     segs = report["segments"]
-    assert [s["gait"] for s in segs] == ["WALK", "TROT", "CANTER", "GALLOP", "CANTER", "TROT", "WALK"]
+    assert [s["gait"] for s in segs] == [
+        "WALK",
+        "TROT",
+        "CANTER",
+        "GALLOP",
+        "CANTER",
+        "TROT",
+        "WALK",
+    ]
     for s in segs:
         assert s["largest_stance_slide"] < 0.005, s["gait"]  # planted feet hold (< 5 mm)
         assert s["largest_swing_jump_ratio"] < 2.5, s["gait"]  # a swinging foot never jumps
@@ -65,10 +72,14 @@ def test_loading_a_file_rebuilds_runtime_state(empty_scene, tmp_path):
     bpy.ops.wm.open_mainfile(filepath=path)
     rig = bpy.data.objects["Horse"]
     assert runtime.last_bake(rig) is None  # stale solver memory dropped...
-    assert rig.kodawari_gait.legs["LF"].bones[0].name == "fore_scapula.L"  # ...settings saved with the file
+    assert (
+        rig.kodawari_gait.legs["LF"].bones[0].name == "fore_scapula.L"
+    )  # ...settings saved with the file
     out = str(tmp_path / "again.png")
     bpy.context.view_layer.objects.active = rig
-    assert bpy.ops.kodawari.gait_report(filepath=out) == {"FINISHED"}  # measured from the saved Action
+    assert bpy.ops.kodawari.gait_report(filepath=out) == {
+        "FINISHED"
+    }  # measured from the saved Action
 
 
 def test_report_measures_what_blender_shows_not_the_keys(empty_scene, tmp_path):

@@ -16,7 +16,15 @@ from gait_scene import (
     select_pose_bones,
 )
 
-CASES = ["wolf", "horse", "cat@0.01", "mixamo@0.01", "unreal+connected", "max_biped@0.01+connected", "game"]
+CASES = [
+    "wolf",
+    "horse",
+    "cat@0.01",
+    "mixamo@0.01",
+    "unreal+connected",
+    "max_biped@0.01+connected",
+    "game",
+]
 LEGS = ("LF", "RF", "LH", "RH")
 
 
@@ -42,7 +50,9 @@ def test_setup_finds_four_legs_by_name_and_from_four_selected_feet(empty_scene, 
     # Root motion lands where Blender applies it: a bone whose location keys count.
     assert s.root_motion == "BONE" and not obj.data.bones[s.body_bone].use_connect
     # Left legs stand on the animal's left (+X for a rig facing -Y), fore legs ahead.
-    world = {k: obj.matrix_world @ obj.data.bones[s.legs[k].bones[-1].name].tail_local for k in LEGS}
+    world = {
+        k: obj.matrix_world @ obj.data.bones[s.legs[k].bones[-1].name].tail_local for k in LEGS
+    }
     assert world["LF"].x > world["RF"].x and world["LH"].x > world["RH"].x
     assert world["LF"].y < world["LH"].y
     # From the four feet selected (in a scrambled order), nothing named needed: same feet,
@@ -55,8 +65,12 @@ def test_setup_finds_four_legs_by_name_and_from_four_selected_feet(empty_scene, 
     assert _feet(obj) == feet
     for k in LEGS:
         chain = [b.name for b in s.legs[k].bones]
-        assert not any("spine" in n.lower() or "hips" in n.lower() or "pelvis" in n.lower() for n in chain), chain
-        assert chain[-len(by_name[k]):] == by_name[k]  # the named chain, perhaps with its shoulder above
+        assert not any(
+            "spine" in n.lower() or "hips" in n.lower() or "pelvis" in n.lower() for n in chain
+        ), chain
+        assert (
+            chain[-len(by_name[k]) :] == by_name[k]
+        )  # the named chain, perhaps with its shoulder above
 
 
 def _ramp(obj, fps):
@@ -73,8 +87,11 @@ def _ramp(obj, fps):
         s.speed = speed
         obj.keyframe_insert(data_path="kodawari_gait.speed", frame=frame)
     # steady: from 0.8 s after a hold starts (the acceleration has caught up) to its end
-    holds = [(keys[0][0] + round(0.8 * fps), keys[1][0], walk), (keys[2][0] + round(1.2 * fps), keys[3][0], gallop),
-             (keys[4][0] + round(1.0 * fps), keys[5][0], walk)]
+    holds = [
+        (keys[0][0] + round(0.8 * fps), keys[1][0], walk),
+        (keys[2][0] + round(1.2 * fps), keys[3][0], gallop),
+        (keys[4][0] + round(1.0 * fps), keys[5][0], walk),
+    ]
     return holds, keys[-1][0]
 
 
@@ -99,21 +116,35 @@ def test_walk_gallop_walk_on_the_rig(empty_scene, case):
     frames = np.arange(1, end + 1)
     legs = evaluated_legs(obj, frames)
     gaits = result["gait"]
-    assert gaits.max() >= 3 and gaits[0] == 0 and gaits[-1] == 0  # it galloped, and walked at both ends
+    assert (
+        gaits.max() >= 3 and gaits[0] == 0 and gaits[-1] == 0
+    )  # it galloped, and walked at both ends
     roots = np.mean([legs[k][:, 0] for k in LEGS], axis=0)
     fore = (legs["LF"][:, 0] + legs["RF"][:, 0]) / 2
     hind = (legs["LH"][:, 0] + legs["RH"][:, 0]) / 2
-    pitch = np.degrees(np.arctan2(fore[:, 2] - hind[:, 2], np.linalg.norm((fore - hind)[:, :2], axis=1)))
+    pitch = np.degrees(
+        np.arctan2(fore[:, 2] - hind[:, 2], np.linalg.norm((fore - hind)[:, :2], axis=1))
+    )
     empty_scene.frame_set(1)
-    rest = {k: np.array(obj.matrix_world @ obj.data.bones[obj.kodawari_gait.legs[k].bones[0].name].head_local)
-            for k in LEGS}
+    rest = {
+        k: np.array(
+            obj.matrix_world @ obj.data.bones[obj.kodawari_gait.legs[k].bones[0].name].head_local
+        )
+        for k in LEGS
+    }
     rest_fore, rest_hind = (rest["LF"] + rest["RF"]) / 2, (rest["LH"] + rest["RH"]) / 2
-    rest_pitch = np.degrees(np.arctan2(rest_fore[2] - rest_hind[2], np.linalg.norm((rest_fore - rest_hind)[:2])))
+    rest_pitch = np.degrees(
+        np.arctan2(rest_fore[2] - rest_hind[2], np.linalg.norm((rest_fore - rest_hind)[:2]))
+    )
     for a, b, speed in holds:
         travelled = np.linalg.norm(roots[b - 1, :2] - roots[a - 1, :2])
         measured = travelled / ((b - a) / fps)
         assert measured == pytest.approx(speed, rel=0.02), (case, a, b, measured, speed)
-        assert np.abs(pitch[a - 1:b] - rest_pitch).max() <= 10.0, (case, a, np.abs(pitch[a - 1:b] - rest_pitch).max())
+        assert np.abs(pitch[a - 1 : b] - rest_pitch).max() <= 10.0, (
+            case,
+            a,
+            np.abs(pitch[a - 1 : b] - rest_pitch).max(),
+        )
     heading = headings(legs)
     for k, leg in enumerate(LEGS):
         planted = result["contacts"][:, k] > 0.5
@@ -154,7 +185,11 @@ def test_planted_joints_never_snap(empty_scene, case, fps):
     top = {e.name: e.speed_max for e in s.table}
     end = 7 * fps
     s.acceleration = 6.0
-    for frame, speed in ((1, 0.7 * top["WALK"]), (end // 2, 0.9 * top["GALLOP"]), (end, 0.7 * top["WALK"])):
+    for frame, speed in (
+        (1, 0.7 * top["WALK"]),
+        (end // 2, 0.9 * top["GALLOP"]),
+        (end, 0.7 * top["WALK"]),
+    ):
         s.speed = speed
         obj.keyframe_insert(data_path="kodawari_gait.speed", frame=frame)
     assert bpy.ops.kodawari.gait_bake(frame_start=1, frame_end=end) == {"FINISHED"}
@@ -163,7 +198,9 @@ def test_planted_joints_never_snap(empty_scene, case, fps):
     heading = headings(legs)
     for k, leg in enumerate(LEGS):
         planted = result["contacts"][:, k] > 0.5
-        step, ratio = planted_snaps(joint_angles(legs[leg], heading), planted, min_stance=1 if fps >= 240 else 4)
+        step, ratio = planted_snaps(
+            joint_angles(legs[leg], heading), planted, min_stance=1 if fps >= 240 else 4
+        )
         if fps >= 240:
             assert step <= 10.0, (case, leg, step)
         else:
@@ -182,11 +219,14 @@ def test_root_motion_defaults_to_the_object_when_the_legs_share_no_bone(empty_sc
     assert obj.kodawari_gait.root_motion == "OBJECT"
 
 
-@pytest.mark.parametrize("case,fault,message", [
-    ("mixamo", "three_legs", r"missing RH"),
-    ("unreal", "one_bone", r"Leg LH \('thigh_l'\) has a single bone"),
-    ("game", "unreachable", r"Leg LF cannot reach the ground"),
-])
+@pytest.mark.parametrize(
+    "case,fault,message",
+    [
+        ("mixamo", "three_legs", r"missing RH"),
+        ("unreal", "one_bone", r"Leg LH \('thigh_l'\) has a single bone"),
+        ("game", "unreachable", r"Leg LF cannot reach the ground"),
+    ],
+)
 def test_a_rig_that_cannot_walk_is_refused_naming_the_leg(empty_scene, case, fault, message):
     obj = build(empty_scene, case)
     bpy.context.view_layer.objects.active = obj
@@ -194,14 +234,19 @@ def test_a_rig_that_cannot_walk_is_refused_naming_the_leg(empty_scene, case, fau
     eb = obj.data.edit_bones
     side = {"mixamo": "mixamorig:Right", "unreal": "_l", "game": "b_Left"}[case]
     if fault == "three_legs":
-        for bone in [b for b in eb if b.name.startswith(side) and ("Leg" in b.name or "Foot" in b.name
-                                                                   or "Toe" in b.name)]:
+        for bone in [
+            b
+            for b in eb
+            if b.name.startswith(side) and ("Leg" in b.name or "Foot" in b.name or "Toe" in b.name)
+        ]:
             eb.remove(bone)
     elif fault == "one_bone":
         for name in ("calf_l", "foot_l", "ball_l"):
             eb.remove(eb[name])
     else:  # the left fore paw lifted 30 cm: its leg is too short to reach the ground
-        for bone in [b for b in eb if b.name.startswith(side) and ("Arm" in b.name or "Hand" in b.name)]:
+        for bone in [
+            b for b in eb if b.name.startswith(side) and ("Arm" in b.name or "Hand" in b.name)
+        ]:
             if not bone.use_connect:
                 bone.head.z += 0.3
             bone.tail.z += 0.3

@@ -3,7 +3,6 @@ refuses bad rigs with a clear message, changing nothing."""
 
 import bpy
 import pytest
-
 from gait_scene import horse
 
 
@@ -76,7 +75,9 @@ def test_finds_legs_from_four_selected_feet(empty_scene):
     assert bpy.ops.kodawari.gait_setup() == {"FINISHED"}
     bpy.ops.object.mode_set(mode="OBJECT")
     legs = {leg.name: [b.name for b in leg.bones] for leg in rig.kodawari_gait.legs}
-    assert legs["LF"] == [names[n] for n in ("fore_scapula.L", "fore_humerus.L", "fore_radius.L", "fore_cannon.L")]
+    assert legs["LF"] == [
+        names[n] for n in ("fore_scapula.L", "fore_humerus.L", "fore_radius.L", "fore_cannon.L")
+    ]
     assert legs["RH"][-1] == names["hind_cannon.R"]
     assert rig.kodawari_gait.body_bone == "body"
 
@@ -93,7 +94,9 @@ def test_not_an_armature(empty_scene):
 def test_fewer_than_four_legs_changes_nothing(empty_scene):
     rig = horse(empty_scene)
     rig.kodawari_gait.legs.clear()
-    for i, bone in enumerate([b for b in rig.data.bones if b.name.startswith("hind_") and b.name.endswith(".R")]):
+    for i, bone in enumerate(
+        [b for b in rig.data.bones if b.name.startswith("hind_") and b.name.endswith(".R")]
+    ):
         bone.name = f"x_{i}.R"  # names that say no limb
     with pytest.raises(RuntimeError, match="fewer than four legs.*missing RH"):
         bpy.ops.kodawari.gait_setup()
@@ -125,7 +128,9 @@ def test_zero_length_bone_in_the_leg_plane_changes_nothing(empty_scene):
 
 
 @pytest.mark.parametrize("case,femur", [("sample_horse", 1), ("wolf", 0)])
-def test_fore_and_hind_legs_get_their_own_stiffness_with_the_hind_femur_leading(empty_scene, case, femur):
+def test_fore_and_hind_legs_get_their_own_stiffness_with_the_hind_femur_leading(
+    empty_scene, case, femur
+):
     """Takizawa: plain CCD moves the bones nearest the foot first; the hind femur should
     lead. The hind femur (below a sloping pelvis on the sample horse, the thigh of the
     Rigify wolf) takes the largest share; the fore leg keeps (0.1, 0.3, 0.5, 1.0)."""

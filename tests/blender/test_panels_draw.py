@@ -12,7 +12,11 @@ from gait_scene import horse
 from hair_rig import add_camera, make_rig, select_only
 from ui_recording import draw_body, kodawari_classes, showing_panels
 
-SETTINGS_PANELS = {"KODAWARI_PT_swim": "swim", "KODAWARI_PT_hair": "hair", "KODAWARI_PT_gait": "gait"}
+SETTINGS_PANELS = {
+    "KODAWARI_PT_swim": "swim",
+    "KODAWARI_PT_hair": "hair",
+    "KODAWARI_PT_gait": "gait",
+}
 
 
 def _settings_panels(prefix):
@@ -80,12 +84,16 @@ def test_gait_panels_draw(empty_scene):
 @pytest.mark.parametrize("prefix", ["KODAWARI_PT_swim", "KODAWARI_PT_hair", "KODAWARI_PT_gait"])
 def test_settings_panels_use_split_layout(empty_scene, prefix):
     """Every setting a panel draws has its label split off, with a keyframe decorator."""
-    {"KODAWARI_PT_swim": lambda: add_swim(make_fish("tuna"), fins=("fin_pectoral",)),
-     "KODAWARI_PT_hair": lambda: _hair_rig(empty_scene),
-     "KODAWARI_PT_gait": lambda: _gait_horse(empty_scene)}[prefix]()
+    {
+        "KODAWARI_PT_swim": lambda: add_swim(make_fish("tuna"), fins=("fin_pectoral",)),
+        "KODAWARI_PT_hair": lambda: _hair_rig(empty_scene),
+        "KODAWARI_PT_gait": lambda: _gait_horse(empty_scene),
+    }[prefix]()
     panels = [p for p in _settings_panels(prefix) if p.poll(bpy.context)]
     assert len(panels) >= 3, "advanced settings are in sub-panels"
-    assert any("DEFAULT_CLOSED" in getattr(p, "bl_options", ()) for p in panels), "some sub-panel starts closed"
+    assert any("DEFAULT_CLOSED" in getattr(p, "bl_options", ()) for p in panels), (
+        "some sub-panel starts closed"
+    )
     for panel in panels:
         props = [e for e in draw_body(panel) if e.kind in ("prop", "prop_search") and not e.in_list]
         unsplit = [e.name for e in props if not e.split]
@@ -115,20 +123,26 @@ def test_feature_panels_hide_on_objects_without_the_feature(empty_scene):
     bpy.context.view_layer.objects.active = gait_horse
     assert not [p.__name__ for p in _settings_panels("KODAWARI_PT_hair") if p.poll(bpy.context)]
     assert [e.name for e in draw_body(bpy.types.KODAWARI_PT_hair_add) if e.kind == "operator"] == [
-        "kodawari.rod_add"]
+        "kodawari.rod_add"
+    ]
 
     mesh = make_fish("tuna")
     bpy.context.view_layer.objects.active = mesh
     assert not [p.__name__ for p in _settings_panels("KODAWARI_PT_swim") if p.poll(bpy.context)]
     assert [e.name for e in draw_body(bpy.types.KODAWARI_PT_swim_add) if e.kind == "operator"] == [
-        "kodawari.swim_add"]
+        "kodawari.swim_add"
+    ]
 
 
 def test_sidebar_tab_shows_the_active_creature(empty_scene):
     obj = make_fish("tuna")
     add_swim(obj)
     panel = bpy.types.KODAWARI_PT_sidebar
-    assert panel.bl_space_type == "VIEW_3D" and panel.bl_region_type == "UI" and panel.bl_category == "Kodawari"
+    assert (
+        panel.bl_space_type == "VIEW_3D"
+        and panel.bl_region_type == "UI"
+        and panel.bl_category == "Kodawari"
+    )
     assert panel.poll(bpy.context)
     entries = draw_body(panel)
     assert "prop frequency" in entries and "operator kodawari.swim_bake" in entries
@@ -138,7 +152,9 @@ def test_sidebar_tab_shows_the_active_creature(empty_scene):
     assert "operator kodawari.rod_add" in entries, "the horse can be given hair from the tab"
 
 
-LABEL_ROOM = 12  # columns of text the label side of a split row shows at the default Properties width
+LABEL_ROOM = (
+    12  # columns of text the label side of a split row shows at the default Properties width
+)
 
 
 def _columns(text):
@@ -154,9 +170,11 @@ def test_split_labels_fit_the_default_width(empty_scene, prefix):
     "Acceleration" and "Swing Height" fit, "Head Amplitude" and "Reference Bone" were cut."""
     from kodawari.translations import ja
 
-    {"KODAWARI_PT_swim": lambda: add_swim(make_fish("tuna"), fins=("fin_pectoral",)),
-     "KODAWARI_PT_hair": lambda: _hair_rig(empty_scene),
-     "KODAWARI_PT_gait": lambda: _gait_horse(empty_scene)}[prefix]()
+    {
+        "KODAWARI_PT_swim": lambda: add_swim(make_fish("tuna"), fins=("fin_pectoral",)),
+        "KODAWARI_PT_hair": lambda: _hair_rig(empty_scene),
+        "KODAWARI_PT_gait": lambda: _gait_horse(empty_scene),
+    }[prefix]()
     too_long = []
     for panel in [p for p in _settings_panels(prefix) if p.poll(bpy.context)]:
         for entry in draw_body(panel):

@@ -19,5 +19,7 @@ def test_bl_info_has_documentation_and_bug_links(addon):
 def test_manifest_names_a_contact_and_a_website(addon):
     with open(os.path.join(ROOT, "addon", "kodawari", "blender_manifest.toml"), "rb") as file:
         manifest = tomllib.load(file)
-    assert "<" in manifest["maintainer"] and "@" in manifest["maintainer"], "maintainer has a contact address"
+    assert "<" in manifest["maintainer"] and "@" in manifest["maintainer"], (
+        "maintainer has a contact address"
+    )
     assert manifest["website"] == addon.bl_info["doc_url"]

@@ -38,7 +38,11 @@ def _small_render_setup(scene, obj):
     scene.collection.objects.link(camera)
     camera.data.type = "ORTHO"
     camera.data.ortho_scale = max(obj.dimensions) * 1.3
-    camera.location = (obj.location.x, obj.location.y, obj.location.z + 10.0)  # from above: the bend shows
+    camera.location = (
+        obj.location.x,
+        obj.location.y,
+        obj.location.z + 10.0,
+    )  # from above: the bend shows
     scene.camera = camera
     light = bpy.data.objects.new("Sun", bpy.data.lights.new("Sun", "SUN"))
     scene.collection.objects.link(light)
@@ -101,7 +105,9 @@ def test_apply_makes_the_current_shape_the_mesh(empty_scene):
     bpy.ops.ed.undo_push(message="Apply Fish Swim")
     bpy.ops.ed.undo()
     obj = bpy.data.objects["tuna"]
-    assert obj.data.shape_keys is not None and obj.kodawari_swim.enabled, "undo brings the swim back"
+    assert obj.data.shape_keys is not None and obj.kodawari_swim.enabled, (
+        "undo brings the swim back"
+    )
     assert np.array_equal(rest(obj), original)
 
 
@@ -130,8 +136,12 @@ def test_a_swim_hidden_in_the_viewport_can_still_be_tuned_and_baked(empty_scene)
     original = rest(obj).copy()
     add_swim(obj)
     obj.kodawari_swim.enabled = False
-    assert bpy.ops.kodawari.swim_fin_add(vertex_group="fin_pectoral", kind="PECTORAL") == {"FINISHED"}
-    assert bpy.ops.kodawari.swim_bake(frame_start=1, frame_end=4, target="SHAPE_KEYS") == {"FINISHED"}
+    assert bpy.ops.kodawari.swim_fin_add(vertex_group="fin_pectoral", kind="PECTORAL") == {
+        "FINISHED"
+    }
+    assert bpy.ops.kodawari.swim_bake(frame_start=1, frame_end=4, target="SHAPE_KEYS") == {
+        "FINISHED"
+    }
     baked = [b for b in obj.data.shape_keys.key_blocks if b.name not in ("Basis", "Kodawari Swim")]
     assert len(baked) == 4
     positions = np.empty((len(baked[2].data), 3), dtype=np.float32)

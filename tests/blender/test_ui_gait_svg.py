@@ -19,14 +19,27 @@ def test_gait_report_writes_a_labelled_svg(empty_scene, tmp_path):
     root = ET.parse(tmp_path / "report.svg").getroot()
     assert root.tag == f"{SVG}svg" and root.get("viewBox"), "a scalable picture"
     texts = [t.text for t in root.iter(f"{SVG}text")]
-    assert "Time (s)" in texts and any(t.startswith("Fore-aft position (m)") for t in texts), "axes with units"
-    assert {"Left fore", "Right fore", "Left hind", "Right hind"} <= set(texts), "legend and rows name the feet"
+    assert "Time (s)" in texts and any(t.startswith("Fore-aft position (m)") for t in texts), (
+        "axes with units"
+    )
+    assert {"Left fore", "Right fore", "Left hind", "Right hind"} <= set(texts), (
+        "legend and rows name the feet"
+    )
     assert "Walk" in texts and "Planted" in texts
-    curves = [p for p in root.iter(f"{SVG}polyline") if p.get("stroke-dasharray") is None
-              and len(p.get("points").split()) > 100]
+    curves = [
+        p
+        for p in root.iter(f"{SVG}polyline")
+        if p.get("stroke-dasharray") is None and len(p.get("points").split()) > 100
+    ]
     assert len(curves) == 4, "one fore-aft curve per foot, every frame"
     # The footfall bars are the bake's planted runs: count them against the contact channels.
     contacts = runtime.last_bake(rig)["result"]["contacts"] > 0.5
-    planted_runs = sum(int(np.sum(np.diff(np.concatenate([[0], c.astype(int), [0]])) == 1)) for c in contacts.T)
-    bars = [r for r in root.iter(f"{SVG}rect") if r.get("fill") == "#1a1a1a" and float(r.get("height")) == 16]
+    planted_runs = sum(
+        int(np.sum(np.diff(np.concatenate([[0], c.astype(int), [0]])) == 1)) for c in contacts.T
+    )
+    bars = [
+        r
+        for r in root.iter(f"{SVG}rect")
+        if r.get("fill") == "#1a1a1a" and float(r.get("height")) == 16
+    ]
     assert len(bars) == planted_runs

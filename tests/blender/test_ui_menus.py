@@ -36,8 +36,11 @@ def _reachable(menu_name, context=None):
 
 
 def _user_operators():
-    return {cls.bl_idname for cls in kodawari_classes("KODAWARI_OT_")
-            if "INTERNAL" not in getattr(cls, "bl_options", set())}
+    return {
+        cls.bl_idname
+        for cls in kodawari_classes("KODAWARI_OT_")
+        if "INTERNAL" not in getattr(cls, "bl_options", set())
+    }
 
 
 def test_every_operator_is_in_the_object_animation_menu(empty_scene):
@@ -51,7 +54,9 @@ def test_rig_operators_are_in_the_pose_menu(empty_scene):
     rig = horse(empty_scene)
     bpy.context.view_layer.objects.active = rig
     found, _ = _reachable("VIEW3D_MT_pose")
-    rig_operators = {name for name in _user_operators() if name.split(".")[1].startswith(("rod_", "gait_"))}
+    rig_operators = {
+        name for name in _user_operators() if name.split(".")[1].startswith(("rod_", "gait_"))
+    }
     assert rig_operators, "no hair or gait operators registered"
     assert not rig_operators - found, f"not in the Pose menu: {sorted(rig_operators - found)}"
 

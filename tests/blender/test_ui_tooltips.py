@@ -43,15 +43,20 @@ def test_units_show(addon):
     from kodawari.gait.props import KodawariGaitEntry as entry
     from kodawari.gait.props import KodawariGaitSettings as gait
     from kodawari.hair.props import KodawariHairRod as hair_rod
+
     assert _prop(fin, "amplitude").subtype == "ANGLE", "fin amplitude is an angle, like phase lag"
     assert _prop(fin, "phase_lag").subtype == "ANGLE"
     assert _prop(swim, "amplitude_head").subtype == "FACTOR", "head amplitude shows three decimals"
     assert _prop(gait, "acceleration").unit == "ACCELERATION"
     assert _prop(gait, "speed").unit == "VELOCITY"
-    assert _prop(entry, "swing_height").subtype == "DISTANCE" and _prop(entry, "swing_height").unit == "LENGTH"
+    assert (
+        _prop(entry, "swing_height").subtype == "DISTANCE"
+        and _prop(entry, "swing_height").unit == "LENGTH"
+    )
     assert _prop(entry, "swing_time").unit in {"TIME", "TIME_ABSOLUTE"}
     assert _prop(entry, "duty_factor").subtype == "FACTOR"
-    assert "°" in _prop(bone, "limit_min").name and "°" in _prop(bone, "limit_max").name, \
+    assert "°" in _prop(bone, "limit_min").name and "°" in _prop(bone, "limit_max").name, (
         "joint limits (stored in degrees) say so"
+    )
     assert _prop(hair_rod, "stiffness").subtype == "FACTOR"
     assert _prop(hair_rod, "wind").unit == "VELOCITY"

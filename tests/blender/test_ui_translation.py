@@ -25,7 +25,9 @@ def test_japanese_covers_every_registered_ui_string(addon):
 @pytest.fixture
 def japanese(addon):
     if not bpy.app.build_options.international:
-        pytest.skip("this Blender build has no translation support (bpy module built without international)")
+        pytest.skip(
+            "this Blender build has no translation support (bpy module built without international)"
+        )
     view = bpy.context.preferences.view
     saved = (view.language, view.use_translate_interface, view.use_translate_tooltips)
     view.language = "ja_JP"
@@ -49,7 +51,9 @@ def _drawn_texts(panel):
         elif entry.kind == "operator":
             if text is None:
                 module, name = entry.name.split(".")
-                texts.append((getattr(getattr(bpy.ops, module), name).get_rna_type().name, "Operator"))
+                texts.append(
+                    (getattr(getattr(bpy.ops, module), name).get_rna_type().name, "Operator")
+                )
             else:
                 texts.append((text, "*"))
         elif entry.kind in ("prop", "prop_search"):
@@ -59,14 +63,19 @@ def _drawn_texts(panel):
 
 @pytest.mark.parametrize("prefix", ["KODAWARI_PT_swim", "KODAWARI_PT_hair", "KODAWARI_PT_gait"])
 def test_panels_draw_japanese(empty_scene, japanese, prefix):
-    {"KODAWARI_PT_swim": lambda: add_swim(make_fish("tuna"), fins=("fin_pectoral",)),
-     "KODAWARI_PT_hair": lambda: _hair_rig(empty_scene),
-     "KODAWARI_PT_gait": lambda: _gait_horse(empty_scene)}[prefix]()
+    {
+        "KODAWARI_PT_swim": lambda: add_swim(make_fish("tuna"), fins=("fin_pectoral",)),
+        "KODAWARI_PT_hair": lambda: _hair_rig(empty_scene),
+        "KODAWARI_PT_gait": lambda: _gait_horse(empty_scene),
+    }[prefix]()
     panels = [p for p in kodawari_classes(prefix) if p.poll(bpy.context)]
     texts = [t for p in panels for t in _drawn_texts(p)]
     assert len(texts) > 10
-    english = [text for text, context in texts
-               if text not in SAME_IN_JAPANESE and pgettext_iface(text, context) == text]
+    english = [
+        text
+        for text, context in texts
+        if text not in SAME_IN_JAPANESE and pgettext_iface(text, context) == text
+    ]
     assert not english, f"drawn untranslated: {english}"
     assert pgettext_iface("Fish Swim") == "魚の泳ぎ"
     assert pgettext_iface("Add Fish Swim", "Operator") == "魚の泳ぎを追加"

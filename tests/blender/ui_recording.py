@@ -9,7 +9,10 @@ import bpy
 
 UILAYOUT_FUNCTIONS = set(bpy.types.UILayout.bl_rna.functions.keys())
 UILAYOUT_PROPERTIES = set(bpy.types.UILayout.bl_rna.properties.keys())
-ICONS = {item.identifier for item in bpy.types.UILayout.bl_rna.functions["label"].parameters["icon"].enum_items}
+ICONS = {
+    item.identifier
+    for item in bpy.types.UILayout.bl_rna.functions["label"].parameters["icon"].enum_items
+}
 
 
 def _has_property(data, name):
@@ -20,7 +23,13 @@ class Entry:
     """One drawn element: kind ("prop", "label", "operator", "menu", ...), name, keywords."""
 
     def __init__(self, kind, name, split, in_list, kwargs):
-        self.kind, self.name, self.split, self.in_list, self.kwargs = kind, name, split, in_list, kwargs
+        self.kind, self.name, self.split, self.in_list, self.kwargs = (
+            kind,
+            name,
+            split,
+            in_list,
+            kwargs,
+        )
 
     def __str__(self):
         return f"{self.kind} {self.name}"
@@ -39,7 +48,9 @@ class OperatorCall:
         self.__dict__["_entry"] = entry
 
     def __setattr__(self, name, value):
-        assert name in self._rna.properties, f"operator {self._rna.identifier} has no property {name!r}"
+        assert name in self._rna.properties, (
+            f"operator {self._rna.identifier} has no property {name!r}"
+        )
         self._entry.kwargs.setdefault("properties", {})[name] = value
 
 
@@ -73,12 +84,16 @@ class RecordingLayout:
         return self._child()
 
     def prop(self, data, name, **kwargs):
-        assert _has_property(data, name.strip('[]"')), f"{type(data).__name__} has no property {name!r}"
+        assert _has_property(data, name.strip('[]"')), (
+            f"{type(data).__name__} has no property {name!r}"
+        )
         self._record("prop", name, dict(kwargs, data=data))
 
     def prop_search(self, data, name, search_data, search_name, **kwargs):
         assert _has_property(data, name), f"{type(data).__name__} has no property {name!r}"
-        assert _has_property(search_data, search_name), f"{type(search_data).__name__} has no {search_name!r}"
+        assert _has_property(search_data, search_name), (
+            f"{type(search_data).__name__} has no {search_name!r}"
+        )
         self._record("prop_search", name, dict(kwargs, data=data))
 
     def label(self, **kwargs):
@@ -96,8 +111,18 @@ class RecordingLayout:
         assert _has_property(data, name) and _has_property(active_data, active_name)
         list_class = getattr(bpy.types, list_type)
         for index, item in enumerate(getattr(data, name)):
-            call(list_class.draw_item, list_class, bpy.context, RecordingLayout(self.log, False, True), data, item,
-                 0, active_data, active_name, index)
+            call(
+                list_class.draw_item,
+                list_class,
+                bpy.context,
+                RecordingLayout(self.log, False, True),
+                data,
+                item,
+                0,
+                active_data,
+                active_name,
+                index,
+            )
         self._record("template_list", name, kwargs)
 
 
@@ -111,7 +136,11 @@ def call(function, owner, context, layout, *args):
 
     stand_in = StandIn()
     stand_in.layout = layout
-    return function(stand_in, context, *args) if not args else function(stand_in, context, layout, *args)
+    return (
+        function(stand_in, context, *args)
+        if not args
+        else function(stand_in, context, layout, *args)
+    )
 
 
 def kodawari_classes(prefix):
@@ -135,8 +164,11 @@ def draw_body(panel, context=None):
 
 def showing_panels(prefix, context=None):
     """{panel name: what it draws} for every Kodawari panel with `prefix` that shows now."""
-    return {panel.__name__: draw_panel(panel, context) for panel in kodawari_classes(prefix)
-            if panel.poll(context or bpy.context)}
+    return {
+        panel.__name__: draw_panel(panel, context)
+        for panel in kodawari_classes(prefix)
+        if panel.poll(context or bpy.context)
+    }
 
 
 def draw_menu_function(function, menu_class, context=None):

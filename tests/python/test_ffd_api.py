@@ -1,9 +1,8 @@
 """kodawari_native's FFD entry points: round trip at rest, shapes, and a bent axis."""
 
+import kodawari_native as kn
 import numpy as np
 import pytest
-
-import kodawari_native as kn
 
 
 def straight_axis(n=5, length=4.0):
@@ -60,8 +59,12 @@ def test_frames_are_orthonormal_with_e1_the_tangent():
     frames = kn.ffd_frames(axis, samples=33)
     assert frames.shape == (33, 4, 3) and frames.dtype == np.float64
     basis = frames[:, 1:, :]
-    np.testing.assert_allclose(basis @ basis.transpose(0, 2, 1), np.broadcast_to(np.eye(3), (33, 3, 3)), atol=1e-9)
-    np.testing.assert_allclose(frames[:, 0, :], kn.curve_points(axis, np.linspace(0, 1, 33)), atol=1e-12)
+    np.testing.assert_allclose(
+        basis @ basis.transpose(0, 2, 1), np.broadcast_to(np.eye(3), (33, 3, 3)), atol=1e-9
+    )
+    np.testing.assert_allclose(
+        frames[:, 0, :], kn.curve_points(axis, np.linspace(0, 1, 33)), atol=1e-12
+    )
 
 
 def test_preserve_lengths_restores_every_segment():

@@ -1,10 +1,9 @@
 """The FFD as a user sees it: rest round trip, rigid motions, smooth frames,
 stable lengths and deterministic output (issue 2, "Must show")."""
 
+import kodawari_native as kn
 import numpy as np
 import pytest
-
-import kodawari_native as kn
 
 
 def helix(n=24, radius=1.0, pitch=0.15, turns=2.5):
@@ -27,7 +26,9 @@ def fish_mesh(count=20000, seed=5):
     x = rng.uniform(-0.3, 4.3, count)
     radius = 0.5 * np.sqrt(np.clip(1 - ((x - 2.0) / 2.4) ** 2, 0, 1)) * rng.random(count)
     angle = rng.uniform(0, 2 * np.pi, count)
-    return np.column_stack([x, radius * np.cos(angle), 0.6 * radius * np.sin(angle)]).astype(np.float32)
+    return np.column_stack([x, radius * np.cos(angle), 0.6 * radius * np.sin(angle)]).astype(
+        np.float32
+    )
 
 
 def rotation(axis, angle):
@@ -44,8 +45,11 @@ def test_deform_at_rest_reproduces_the_mesh(axis_name):
     pick = rng.integers(0, 4001, 20000)
     angle = rng.uniform(0, 2 * np.pi, 20000)
     radius = 0.3 * rng.random(20000)
-    mesh = (frames[pick, 0] + (radius * np.cos(angle))[:, None] * frames[pick, 2]
-            + (radius * np.sin(angle))[:, None] * frames[pick, 3]).astype(np.float32)
+    mesh = (
+        frames[pick, 0]
+        + (radius * np.cos(angle))[:, None] * frames[pick, 2]
+        + (radius * np.sin(angle))[:, None] * frames[pick, 3]
+    ).astype(np.float32)
     twist = np.linspace(0.0, 0.8, len(axis))
     binding = kn.ffd_bind(axis, mesh, twist=twist)
     out = np.empty_like(mesh)
@@ -70,7 +74,11 @@ def test_snout_and_tail_tip_follow_the_end_frames():
     axis, mesh = fish_axis(), fish_mesh()
     binding = kn.ffd_bind(axis, mesh)
     past_tail = mesh[:, 0] > 4.0
-    assert past_tail.any() and np.all(binding.w[past_tail] > 0) and np.all(binding.w[mesh[:, 0] < 0] < 0)
+    assert (
+        past_tail.any()
+        and np.all(binding.w[past_tail] > 0)
+        and np.all(binding.w[mesh[:, 0] < 0] < 0)
+    )
     bent = axis.copy()
     bent[5] = bent[4] + [0.0, 0.8, 0.0]  # tail leg turned 90 degrees
     out = np.empty_like(mesh)

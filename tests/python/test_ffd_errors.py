@@ -1,9 +1,8 @@
 """Every bad input to the FFD raises ValueError naming the argument, never a crash."""
 
+import kodawari_native as kn
 import numpy as np
 import pytest
-
-import kodawari_native as kn
 
 AXIS = np.column_stack([np.linspace(0.0, 4.0, 5), np.zeros(5), np.zeros(5)])
 MESH = np.random.default_rng(0).random((50, 3)).astype(np.float32)
@@ -66,8 +65,11 @@ def test_bad_vertices(case):
         kn.ffd_bind(AXIS, BAD_VERTICES[case])
 
 
-@pytest.mark.parametrize("bad", [np.zeros(4), np.zeros(5, np.float32), np.array([0, 0, np.nan, 0, 0.0]),
-                                 np.zeros((5, 1))], ids=["length", "dtype", "NaN", "shape"])
+@pytest.mark.parametrize(
+    "bad",
+    [np.zeros(4), np.zeros(5, np.float32), np.array([0, 0, np.nan, 0, 0.0]), np.zeros((5, 1))],
+    ids=["length", "dtype", "NaN", "shape"],
+)
 def test_bad_twist(bad):
     with pytest.raises(ValueError, match="twist"):
         kn.ffd_bind(AXIS, MESH, twist=bad)
@@ -77,8 +79,11 @@ def test_bad_twist(bad):
         kn.ffd_frames(AXIS, twist=bad)
 
 
-@pytest.mark.parametrize("bad", [np.zeros(2), np.array([1.0, 0.0, 0.0]), np.zeros(3), np.array([0, np.inf, 0.0])],
-                         ids=["shape", "parallel to the tangent", "zero", "inf"])
+@pytest.mark.parametrize(
+    "bad",
+    [np.zeros(2), np.array([1.0, 0.0, 0.0]), np.zeros(3), np.array([0, np.inf, 0.0])],
+    ids=["shape", "parallel to the tangent", "zero", "inf"],
+)
 def test_bad_up(bad):
     with pytest.raises(ValueError, match="up"):
         kn.ffd_bind(AXIS, MESH, up=bad)
@@ -86,9 +91,16 @@ def test_bad_up(bad):
         kn.ffd_bind(AXIS, MESH).deform(AXIS, np.empty_like(MESH), up=bad)
 
 
-@pytest.mark.parametrize("bad", [np.empty((49, 3), np.float32), np.empty((50, 3), np.float64),
-                                 np.empty((100, 3), np.float32)[::2], "readonly"],
-                         ids=["rows", "dtype", "non-contiguous", "read-only"])
+@pytest.mark.parametrize(
+    "bad",
+    [
+        np.empty((49, 3), np.float32),
+        np.empty((50, 3), np.float64),
+        np.empty((100, 3), np.float32)[::2],
+        "readonly",
+    ],
+    ids=["rows", "dtype", "non-contiguous", "read-only"],
+)
 def test_bad_out(bad):
     if isinstance(bad, str):
         bad = np.empty((50, 3), np.float32)

@@ -6,16 +6,17 @@ import importlib.util
 import os
 import sys
 
+import kodawari_native as kn
 import numpy as np
 import pytest
 
-import kodawari_native as kn
-
 sys.path.insert(0, os.path.dirname(__file__))
-from gait_rigs import horse_rig, limits, neutral  # noqa: E402
+from gait_rigs import horse_rig, limits, neutral
 
 _ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-_spec = importlib.util.spec_from_file_location("gait_metrics", os.path.join(_ROOT, "addon/kodawari/gait/metrics.py"))
+_spec = importlib.util.spec_from_file_location(
+    "gait_metrics", os.path.join(_ROOT, "addon/kodawari/gait/metrics.py")
+)
 metrics = importlib.util.module_from_spec(_spec)
 _spec.loader.exec_module(metrics)
 
@@ -32,11 +33,24 @@ def bake(speed, mode, fps, iterations=64, rig=None, table=None):
 
 def measure(out, rig, fps, keep=slice(None)):
     lo, hi = limits(rig)
-    return metrics.measure(out["feet"][keep], out["roots"][keep], out["headings"][keep], out["contacts"][keep],
-                           out["gait"][keep], out["angles"][keep], lo, hi, neutral(rig), out["reach"], fps)
+    return metrics.measure(
+        out["feet"][keep],
+        out["roots"][keep],
+        out["headings"][keep],
+        out["contacts"][keep],
+        out["gait"][keep],
+        out["angles"][keep],
+        lo,
+        hi,
+        neutral(rig),
+        out["reach"],
+        fps,
+    )
 
 
-@pytest.mark.parametrize("gait,speed", [(WALK, 1.2), (TROT, 3.5), (CANTER, 5.5), (GALLOP, 12.0), (ROTARY, 12.0)])
+@pytest.mark.parametrize(
+    "gait,speed", [(WALK, 1.2), (TROT, 3.5), (CANTER, 5.5), (GALLOP, 12.0), (ROTARY, 12.0)]
+)
 def test_steady_gait_matches_the_table(gait, speed):
     fps = 240
     out, rig = bake(np.full(6 * fps, speed), gait, fps)
@@ -72,13 +86,23 @@ def test_speed_ramp_through_every_gait_is_smooth():
     fps = 24
     out, rig = bake(speed_ramp(fps), -1, fps)
     segs = measure(out, rig, fps)
-    assert [s["gait"] for s in segs] == ["WALK", "TROT", "CANTER", "GALLOP", "CANTER", "TROT", "WALK"]
+    assert [s["gait"] for s in segs] == [
+        "WALK",
+        "TROT",
+        "CANTER",
+        "GALLOP",
+        "CANTER",
+        "TROT",
+        "WALK",
+    ]
     for s in segs:
         assert s["largest_stance_slide"] < 0.005, s  # a planted foot stays put
         assert s["largest_swing_jump_ratio"] < 2.5, s  # no one-frame jump in a swing
         assert s["joint_limit_violations"] == 0, s
         for name in metrics.LEGS:  # every foot within reach (5 mm for float rounding)
-            assert s["legs"][name]["largest_foot_root_distance"] <= s["legs"][name]["reach"] + 0.005, (s["gait"], name)
+            assert (
+                s["legs"][name]["largest_foot_root_distance"] <= s["legs"][name]["reach"] + 0.005
+            ), (s["gait"], name)
     assert np.isfinite(out["angles"]).all()
 
 
@@ -89,12 +113,22 @@ def test_swinging_hooves_follow_their_path_at_any_frame_rate(fps):
     # off its path and snap back in one frame (jump ratio 4.5).
     out, rig = bake(speed_ramp(fps), -1, fps)
     segs = measure(out, rig, fps)
-    assert [s["gait"] for s in segs] == ["WALK", "TROT", "CANTER", "GALLOP", "CANTER", "TROT", "WALK"]
+    assert [s["gait"] for s in segs] == [
+        "WALK",
+        "TROT",
+        "CANTER",
+        "GALLOP",
+        "CANTER",
+        "TROT",
+        "WALK",
+    ]
     # The same criteria measured on the planner's own path: what the hoof may not exceed.
     path = dict(out, feet=out["feet_planned"])
     for s, planned in zip(segs, measure(path, rig, fps)):
         assert s["largest_swing_jump_ratio"] < 1.5, s  # no one-frame jump in a swing
-        assert s["largest_swing_acceleration"] <= 1.25 * planned["largest_swing_acceleration"] + 50, s["gait"]
+        assert (
+            s["largest_swing_acceleration"] <= 1.25 * planned["largest_swing_acceleration"] + 50
+        ), s["gait"]
         assert s["largest_stance_slide"] < 0.005, s
         assert s["joint_limit_violations"] == 0, s
     # The hoof is where the planner put it, to 2 cm (strides are 1.5 to 7 m).
@@ -110,8 +144,11 @@ def test_swinging_hooves_follow_their_path_at_any_frame_rate(fps):
             down = downs[downs > lift]
             if not len(down) or down[0] - lift < 4:
                 continue
-            assert not c[lift:down[0], leg].any()
-            height = out["feet_planned"][lift:down[0], leg, 2].max() - out["feet_planned"][lift - 1, leg, 2]
+            assert not c[lift : down[0], leg].any()
+            height = (
+                out["feet_planned"][lift : down[0], leg, 2].max()
+                - out["feet_planned"][lift - 1, leg, 2]
+            )
             swings += 1
             lowered += height < 0.9 * table["gaits"][out["gait"][lift]][4]
     assert swings > 200 and lowered <= 0.03 * swings, (lowered, swings)
@@ -126,7 +163,9 @@ def test_a_swing_across_a_gait_change_is_measured_whole():
     t = np.clip((np.arange(frames) - 4) / 10.0, 0, 1)
     feet = np.zeros((frames, 4, 3))
     feet[:, :, 1] = (t * t * (3 - 2 * t))[:, None]
-    jump, ratio, accel = metrics.swing_smoothness(feet, contacts, 0, 0, 6, 24)  # gait changes at frame 6
+    jump, ratio, accel = metrics.swing_smoothness(
+        feet, contacts, 0, 0, 6, 24
+    )  # gait changes at frame 6
     assert ratio < 1.5 and jump < 0.02
     feet[9, 0, 1] += 0.2  # a real one-frame jump is still caught
     assert metrics.swing_smoothness(feet, contacts, 0, 0, 12, 24)[1] > 2
@@ -150,7 +189,12 @@ def test_transition_completes_within_two_strides():
     fps = 240
     n = 8 * fps
     change = 3 * fps
-    for old, new, speed in [(WALK, TROT, 1.8), (TROT, CANTER, 5.0), (CANTER, GALLOP, 7.0), (GALLOP, ROTARY, 12.0)]:
+    for old, new, speed in [
+        (WALK, TROT, 1.8),
+        (TROT, CANTER, 5.0),
+        (CANTER, GALLOP, 7.0),
+        (GALLOP, ROTARY, 12.0),
+    ]:
         mode = np.where(np.arange(n) < change, old, new)
         out, rig = bake(np.full(n, speed), mode, fps)
         table = kn.gait_horse_table()
@@ -184,7 +228,10 @@ def test_transition_completes_within_two_strides():
         assert max(s["largest_stance_slide"] for s in seg) < 0.005
         for s in seg:
             for name in metrics.LEGS:
-                assert s["legs"][name]["largest_foot_root_distance"] <= s["legs"][name]["reach"] + 0.005
+                assert (
+                    s["legs"][name]["largest_foot_root_distance"]
+                    <= s["legs"][name]["reach"] + 0.005
+                )
 
 
 def test_speed_zero_stands_still():
@@ -249,7 +296,11 @@ def test_gallop_stride_lengthens_at_low_gallop_speed():
         out, rig = bake(np.full(5 * fps, speed), GALLOP, fps)
         seg = measure(out, rig, fps, slice(2 * fps, None))[0]
         for name in metrics.LEGS:
-            assert lo <= seg["legs"][name]["stride"] <= hi, (speed, name, seg["legs"][name]["stride"])
+            assert lo <= seg["legs"][name]["stride"] <= hi, (
+                speed,
+                name,
+                seg["legs"][name]["stride"],
+            )
 
 
 def test_table_scales_with_leg_length_by_froude_number():
@@ -286,7 +337,9 @@ def test_bad_arrays_raise_clear_errors():
     bad["legs"][1]["tail"] = bad["legs"][1]["heads"][0] + np.array([0.0, 0.0, -0.5])
     assert "RF has 1 bone" in kn.gait_validate_rig(bad)
     flat = horse_rig()
-    flat["legs"][0]["tail"] = flat["legs"][0]["heads"][-1] + np.array([0.3, 0.0, 0.0])  # sideways: no length
+    flat["legs"][0]["tail"] = flat["legs"][0]["heads"][-1] + np.array(
+        [0.3, 0.0, 0.0]
+    )  # sideways: no length
     assert "zero length" in kn.gait_validate_rig(flat)
 
 

@@ -10,4 +10,4 @@ def test_version_matches_the_addon():
 
 
 def test_built_for_this_python():
-    assert kodawari_native.PYTHON_ABI == sys.version_info[0] * 100 + sys.version_info[1]
+    assert sys.version_info[0] * 100 + sys.version_info[1] == kodawari_native.PYTHON_ABI

@@ -1,8 +1,6 @@
 """Apply Fish Swim: like applying a modifier, the shape the fish has at the current
 frame becomes its mesh and the swim is removed (one undo step takes it back)."""
 
-# ruff: noqa: RUF012
-
 import bpy
 from bpy.app.translations import pgettext_tip as tip_
 

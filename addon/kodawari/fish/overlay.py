@@ -27,8 +27,8 @@ def axis_polylines(obj):
     kn = native.module()
     curve = kn.curve_points(rig.axis, np.linspace(0.0, 1.0, CURVE_SAMPLES))
     world = np.array(obj.matrix_world)
-    to_world = lambda p: p @ world[:3, :3].T + world[:3, 3]
-    return to_world(curve), to_world(rig.axis)
+    rotation, offset = world[:3, :3].T, world[:3, 3]
+    return curve @ rotation + offset, rig.axis @ rotation + offset
 
 
 def _shader():

@@ -2,9 +2,6 @@
 toggles in the header, where it runs in the stack, the everyday settings on top,
 the rest in sub-panels (body wave and travel start closed)."""
 
-# bl_options sets are Blender's class-attribute convention, never mutated.
-# ruff: noqa: RUF012
-
 import bpy
 from bpy.app.translations import pgettext_iface as iface_
 
@@ -225,8 +222,16 @@ class KODAWARI_PT_swim_order(_SwimPanel, bpy.types.Panel):
             col.label(text=f"{index}. {modifier.name}", icon=icon, translate=False)
 
 
-KODAWARI_PT_swim_add = in_use.add_panel("KODAWARI_PT_swim_add", "Fish Swim", "modifier", in_use.can_swim,
-                                         in_use.swim, "kodawari.swim_add", "Add Fish Swim", "MOD_WAVE")
+KODAWARI_PT_swim_add = in_use.add_panel(
+    "KODAWARI_PT_swim_add",
+    "Fish Swim",
+    "modifier",
+    in_use.can_swim,
+    in_use.swim,
+    "kodawari.swim_add",
+    "Add Fish Swim",
+    "MOD_WAVE",
+)
 
 
 CLASSES = (

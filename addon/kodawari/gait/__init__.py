@@ -17,9 +17,11 @@ CLASSES = (
 )
 
 PROPERTIES = (
-    (bpy.types.Object, "kodawari_gait", lambda: bpy.props.PointerProperty(type=props.KodawariGaitSettings)),
+    (
+        bpy.types.Object,
+        "kodawari_gait",
+        lambda: bpy.props.PointerProperty(type=props.KodawariGaitSettings),
+    ),
 )
 
-HANDLERS = (
-    ("load_post", handlers.on_load),
-)
+HANDLERS = (("load_post", handlers.on_load),)

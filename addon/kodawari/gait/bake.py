@@ -12,7 +12,9 @@ from . import runtime
 from .props import GAIT_NAMES, LEG_NAMES
 
 CONTACT_PROPS = tuple(f"kodawari_contact_{leg}" for leg in LEG_NAMES)
-GAIT_PROP = "kodawari_gait_index"  # the gait in use per frame (0 WALK .. 4 GALLOP_ROTARY), for the report
+GAIT_PROP = (
+    "kodawari_gait_index"  # the gait in use per frame (0 WALK .. 4 GALLOP_ROTARY), for the report
+)
 
 
 def _sample_channel(obj, data_path, frames, constant):
@@ -83,16 +85,27 @@ def _heightfield(context, obj, ground, rig, lo, hi, max_cells=256):
     for j in range(ny):
         y = lo[1] + j * cell
         for i in range(nx):
-            hit = tree.ray_cast(to_ground @ (origin + Vector((lo[0] + i * cell, y, top))), direction)
+            hit = tree.ray_cast(
+                to_ground @ (origin + Vector((lo[0] + i * cell, y, top))), direction
+            )
             if hit[0] is None:
                 heights[j * nx + i] = np.nan
                 misses += 1
             else:
                 heights[j * nx + i] = (ground.matrix_world @ hit[0]).z - origin.z
     if misses:
-        raise ValueError(f"the ground '{ground.name}' does not lie under the whole run "
-                         f"({misses} of {nx * ny} rays missed): move or enlarge it, or clear Ground")
-    return {"x0": float(lo[0]), "y0": float(lo[1]), "cell": cell, "nx": nx, "ny": ny, "heights": heights}
+        raise ValueError(
+            f"the ground '{ground.name}' does not lie under the whole run "
+            f"({misses} of {nx * ny} rays missed): move or enlarge it, or clear Ground"
+        )
+    return {
+        "x0": float(lo[0]),
+        "y0": float(lo[1]),
+        "cell": cell,
+        "nx": nx,
+        "ny": ny,
+        "heights": heights,
+    }
 
 
 def object_motion(rig, result):
@@ -103,10 +116,14 @@ def object_motion(rig, result):
     pivot's travel less the rotated pivot."""
     q = result["body_rotation"] / np.linalg.norm(result["body_rotation"], axis=1, keepdims=True)
     w, x, y, z = q.T
-    rot = np.stack([
-        np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)], axis=1),
-        np.stack([2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)], axis=1),
-        np.stack([2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)], axis=1)], axis=1)
+    rot = np.stack(
+        [
+            np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)], axis=1),
+            np.stack([2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)], axis=1),
+            np.stack([2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)], axis=1),
+        ],
+        axis=1,
+    )
     pivot = rig["body_head"]
     head = pivot[None, :] + result["body_location"]
     return head - rot @ pivot, q
@@ -140,8 +157,10 @@ class GaitBakeJob(BakeJob):
         self.fps = self.scene.render.fps / self.scene.render.fps_base
         self.rig, self.chains = rigmod.rig_dict(obj, settings)
         if self.rig["on_object"] and obj.rotation_mode not in ("XYZ", "QUATERNION"):
-            raise ValueError(f"root motion on the object keys its delta rotation: set '{obj.name}' to the XYZ Euler "
-                             f"or Quaternion rotation mode (it is {obj.rotation_mode})")
+            raise ValueError(
+                f"root motion on the object keys its delta rotation: set '{obj.name}' to the XYZ Euler "
+                f"or Quaternion rotation mode (it is {obj.rotation_mode})"
+            )
         self.table = rigmod.table_dict(settings)
         why = kn.gait_validate_table(self.table)
         if why:
@@ -152,31 +171,49 @@ class GaitBakeJob(BakeJob):
         mode = np.clip(np.round(mode), -1, 4)
         if (speed < 0).any():
             f = int(self.frames[np.argmax(speed < 0)])
-            raise ValueError(f"speed is negative ({speed[speed < 0][0]:.2f} m/s at frame {f}): "
-                             "key speeds of 0 or more")
+            raise ValueError(
+                f"speed is negative ({speed[speed < 0][0]:.2f} m/s at frame {f}): "
+                "key speeds of 0 or more"
+            )
         length = rigmod.leg_length(self.rig)
-        frame, top = kn.gait_check_speeds(self.table, np.ascontiguousarray(speed),
-                                          np.ascontiguousarray(mode, dtype=np.float64), length)
+        frame, top = kn.gait_check_speeds(
+            self.table,
+            np.ascontiguousarray(speed),
+            np.ascontiguousarray(mode, dtype=np.float64),
+            length,
+        )
         if frame >= 0:
             g = int(mode[frame])
             what = "the gait table" if g < 0 else GAIT_NAMES[g]
-            raise ValueError(f"speed {speed[frame]:.2f} m/s at frame {int(self.frames[frame])} is past the range of "
-                             f"{what} (top {top:.2f} m/s): lower it or raise the table's top speed")
+            raise ValueError(
+                f"speed {speed[frame]:.2f} m/s at frame {int(self.frames[frame])} is past the range of "
+                f"{what} (top {top:.2f} m/s): lower it or raise the table's top speed"
+            )
         path = _path_points(context, obj, settings.path) if settings.path is not None else None
         ground = None
         if settings.ground is not None:
             lo, hi = _run_region(self.rig, speed, self.fps, path, margin=1.0)
             ground = _heightfield(context, obj, settings.ground, self.rig, lo, hi)
-        result = kn.gait_bake(self.rig, self.table, np.ascontiguousarray(speed),
-                              np.ascontiguousarray(mode, dtype=np.float64), float(self.fps),
-                              float(settings.acceleration), int(settings.ccd_iterations), path=path, ground=ground)
+        result = kn.gait_bake(
+            self.rig,
+            self.table,
+            np.ascontiguousarray(speed),
+            np.ascontiguousarray(mode, dtype=np.float64),
+            float(self.fps),
+            float(settings.acceleration),
+            int(settings.ccd_iterations),
+            path=path,
+            ground=ground,
+        )
         if ground is not None:
             planted = result["contacts"] > 0.5
             miss = np.where(planted, result["ik_error"], 0.0)
             if miss.max() > 0.02:
                 f = int(self.frames[np.argmax(miss.max(axis=1))])
-                raise ValueError(f"the ground '{settings.ground.name}' is out of the legs' reach (a planted foot "
-                                 f"misses it by {miss.max():.2f} m at frame {f})")
+                raise ValueError(
+                    f"the ground '{settings.ground.name}' is out of the legs' reach (a planted foot "
+                    f"misses it by {miss.max():.2f} m at frame {f})"
+                )
         self.result = result
         self.axes = rigmod.hinge_axes(obj, self.chains, self.rig["forward"])
         self._started = False
@@ -188,8 +225,11 @@ class GaitBakeJob(BakeJob):
         self._old_action = anim.action if anim is not None else None
         self._old_slot = fcurves.current_slot_identifier(obj)
         self._old_modes = {pb.name: pb.rotation_mode for pb in obj.pose.bones}
-        self._old_deltas = (tuple(obj.delta_location), tuple(obj.delta_rotation_euler),
-                            tuple(obj.delta_rotation_quaternion))
+        self._old_deltas = (
+            tuple(obj.delta_location),
+            tuple(obj.delta_rotation_euler),
+            tuple(obj.delta_rotation_quaternion),
+        )
         self._old_props = {k: obj[k] for k in CONTACT_PROPS + (GAIT_PROP,) if k in obj.keys()}
         # A new Action (the old one stays untouched until finish, so Esc can put it
         # back); the curves this bake does not own (the speed keys, other bones) are
@@ -197,9 +237,14 @@ class GaitBakeJob(BakeJob):
         owned = self._owned_paths()
         kept = []
         if self._old_action is not None:
-            kept = [fcurves.copy_keys(c) for c in fcurves.action_fcurves(self._old_action, obj)
-                    if c.data_path not in owned]
-        action = bpy.data.actions.new(self._old_action.name if self._old_action else f"{obj.name}Gait")
+            kept = [
+                fcurves.copy_keys(c)
+                for c in fcurves.action_fcurves(self._old_action, obj)
+                if c.data_path not in owned
+            ]
+        action = bpy.data.actions.new(
+            self._old_action.name if self._old_action else f"{obj.name}Gait"
+        )
         self.action = action
         fcurves.assign_action(obj, action, None)
         for data in kept:
@@ -214,7 +259,9 @@ class GaitBakeJob(BakeJob):
             paths.update(("delta_location", "delta_rotation_euler", "delta_rotation_quaternion"))
         else:
             body = self.obj.kodawari_gait.body_bone
-            paths.update((f'pose.bones["{body}"].location', f'pose.bones["{body}"].rotation_quaternion'))
+            paths.update(
+                (f'pose.bones["{body}"].location', f'pose.bones["{body}"].rotation_quaternion')
+            )
         paths.update(f'["{p}"]' for p in CONTACT_PROPS + (GAIT_PROP,))
         return paths
 
@@ -238,41 +285,100 @@ class GaitBakeJob(BakeJob):
                     obj.pose.bones[name].rotation_mode = "XYZ"
                     euler = np.zeros((len(frames), 3))
                     euler[:, 0] = sign * r["angles"][:, col]
-                    fcurves.write_channels(action, obj, f'pose.bones["{name}"].rotation_euler', frames,
-                                           euler[:, :1], group=name)
+                    fcurves.write_channels(
+                        action,
+                        obj,
+                        f'pose.bones["{name}"].rotation_euler',
+                        frames,
+                        euler[:, :1],
+                        group=name,
+                    )
                 else:
                     obj.pose.bones[name].rotation_mode = "QUATERNION"
                     half = r["angles"][:, col] / 2
-                    quat = np.stack([np.cos(half), axis[0] * np.sin(half), axis[1] * np.sin(half),
-                                     axis[2] * np.sin(half)], axis=1)
-                    fcurves.write_channels(action, obj, f'pose.bones["{name}"].rotation_quaternion', frames,
-                                           quat, group=name)
+                    quat = np.stack(
+                        [
+                            np.cos(half),
+                            axis[0] * np.sin(half),
+                            axis[1] * np.sin(half),
+                            axis[2] * np.sin(half),
+                        ],
+                        axis=1,
+                    )
+                    fcurves.write_channels(
+                        action,
+                        obj,
+                        f'pose.bones["{name}"].rotation_quaternion',
+                        frames,
+                        quat,
+                        group=name,
+                    )
             elif kind == "body" and self.rig["on_object"]:
                 # Root motion on the object, in its delta transforms (its own location,
                 # rotation and scale stay the user's placement).
                 location, quat = object_motion(self.rig, r)
-                fcurves.write_channels(action, obj, "delta_location", frames, location, group="Object Transforms")
+                fcurves.write_channels(
+                    action, obj, "delta_location", frames, location, group="Object Transforms"
+                )
                 if obj.rotation_mode == "QUATERNION":
-                    fcurves.write_channels(action, obj, "delta_rotation_quaternion", frames, quat,
-                                           group="Object Transforms")
+                    fcurves.write_channels(
+                        action,
+                        obj,
+                        "delta_rotation_quaternion",
+                        frames,
+                        quat,
+                        group="Object Transforms",
+                    )
                 else:
-                    fcurves.write_channels(action, obj, "delta_rotation_euler", frames, euler_xyz(quat),
-                                           group="Object Transforms")
+                    fcurves.write_channels(
+                        action,
+                        obj,
+                        "delta_rotation_euler",
+                        frames,
+                        euler_xyz(quat),
+                        group="Object Transforms",
+                    )
             elif kind == "body":
                 obj.pose.bones[name].rotation_mode = "QUATERNION"
                 # The core solved in world metres: a bone's location is in armature units.
-                fcurves.write_channels(action, obj, f'pose.bones["{name}"].location', frames,
-                                       r["body_location"] / self.rig["scale"], group=name)
-                fcurves.write_channels(action, obj, f'pose.bones["{name}"].rotation_quaternion', frames,
-                                       r["body_rotation"], group=name)
+                fcurves.write_channels(
+                    action,
+                    obj,
+                    f'pose.bones["{name}"].location',
+                    frames,
+                    r["body_location"] / self.rig["scale"],
+                    group=name,
+                )
+                fcurves.write_channels(
+                    action,
+                    obj,
+                    f'pose.bones["{name}"].rotation_quaternion',
+                    frames,
+                    r["body_rotation"],
+                    group=name,
+                )
             else:
                 for k, prop in enumerate(CONTACT_PROPS):
                     obj[prop] = float(r["contacts"][0, k])
-                    fcurves.write_channels(action, obj, f'["{prop}"]', frames, r["contacts"][:, k],
-                                           group="Kodawari Gait", interpolation="CONSTANT")
+                    fcurves.write_channels(
+                        action,
+                        obj,
+                        f'["{prop}"]',
+                        frames,
+                        r["contacts"][:, k],
+                        group="Kodawari Gait",
+                        interpolation="CONSTANT",
+                    )
                 obj[GAIT_PROP] = float(r["gait"][0])
-                fcurves.write_channels(action, obj, f'["{GAIT_PROP}"]', frames, r["gait"].astype(np.float64),
-                                       group="Kodawari Gait", interpolation="CONSTANT")
+                fcurves.write_channels(
+                    action,
+                    obj,
+                    f'["{GAIT_PROP}"]',
+                    frames,
+                    r["gait"].astype(np.float64),
+                    group="Kodawari Gait",
+                    interpolation="CONSTANT",
+                )
             yield (i + 1) / len(jobs)
 
     def finish(self):
@@ -297,7 +403,9 @@ class GaitBakeJob(BakeJob):
         for name, mode in self._old_modes.items():
             if name in obj.pose.bones:
                 obj.pose.bones[name].rotation_mode = mode
-        obj.delta_location, obj.delta_rotation_euler, obj.delta_rotation_quaternion = self._old_deltas
+        obj.delta_location, obj.delta_rotation_euler, obj.delta_rotation_quaternion = (
+            self._old_deltas
+        )
         for key in CONTACT_PROPS + (GAIT_PROP,):
             if key in self._old_props:
                 obj[key] = self._old_props[key]

@@ -15,17 +15,104 @@ _WORDS = re.compile(r"[A-Z]+(?![a-z])|[A-Z]?[a-z]+|\d+")
 _LEFT, _RIGHT = {"left", "l", "lft"}, {"right", "r", "rgt", "rt"}
 # A word that says the bone is a fore limb wins over one that says "leg" ("front_thigh",
 # "forefoot", "f_toe": Rigify's fore paws and hooves reuse the hind words).
-_FORE = {"fore", "front", "f", "arm", "upperarm", "forearm", "lowerarm", "hand", "humerus", "radius", "ulna",
-         "scapula", "wrist", "forefoot", "carpus", "carpal", "metacarpus", "elbow", "frontleg", "foreleg"}
-_HIND = {"hind", "back", "rear", "thigh", "shin", "calf", "leg", "upleg", "foot", "toe", "toes", "toebase",
-         "hoof", "femur", "tibia", "fibula", "hock", "tarsus", "metatarsus", "ball", "knee", "ankle", "paw",
-         "cannon", "pastern", "hindleg", "backleg", "hip"}
+_FORE = {
+    "fore",
+    "front",
+    "f",
+    "arm",
+    "upperarm",
+    "forearm",
+    "lowerarm",
+    "hand",
+    "humerus",
+    "radius",
+    "ulna",
+    "scapula",
+    "wrist",
+    "forefoot",
+    "carpus",
+    "carpal",
+    "metacarpus",
+    "elbow",
+    "frontleg",
+    "foreleg",
+}
+_HIND = {
+    "hind",
+    "back",
+    "rear",
+    "thigh",
+    "shin",
+    "calf",
+    "leg",
+    "upleg",
+    "foot",
+    "toe",
+    "toes",
+    "toebase",
+    "hoof",
+    "femur",
+    "tibia",
+    "fibula",
+    "hock",
+    "tarsus",
+    "metatarsus",
+    "ball",
+    "knee",
+    "ankle",
+    "paw",
+    "cannon",
+    "pastern",
+    "hindleg",
+    "backleg",
+    "hip",
+}
 # Bones that are never a leg's: digits of a hand, rig helpers, generated mechanism bones,
 # the girdles (a clavicle or Rigify's pelvis.L runs from the spine to the hip sideways).
-_NOT_LEG = {"finger", "thumb", "index", "middle", "ring", "pinky", "twist", "roll", "ik", "pole", "target", "mch",
-            "org", "vis", "tweak", "ctrl", "nub", "end", "helper", "breast", "clavicle", "shoulder", "pelvis",
-            "heel", "palm", "hips", "spine", "ear", "eye", "lid", "brow", "lip", "cheek", "nose", "tail"}
-_EXPLICIT = {"fore", "front", "hind", "back", "rear"}  # these make any bone a leg bone ("fore_scapula")
+_NOT_LEG = {
+    "finger",
+    "thumb",
+    "index",
+    "middle",
+    "ring",
+    "pinky",
+    "twist",
+    "roll",
+    "ik",
+    "pole",
+    "target",
+    "mch",
+    "org",
+    "vis",
+    "tweak",
+    "ctrl",
+    "nub",
+    "end",
+    "helper",
+    "breast",
+    "clavicle",
+    "shoulder",
+    "pelvis",
+    "heel",
+    "palm",
+    "hips",
+    "spine",
+    "ear",
+    "eye",
+    "lid",
+    "brow",
+    "lip",
+    "cheek",
+    "nose",
+    "tail",
+}
+_EXPLICIT = {
+    "fore",
+    "front",
+    "hind",
+    "back",
+    "rear",
+}  # these make any bone a leg bone ("fore_scapula")
 
 
 def words(name):
@@ -33,7 +120,7 @@ def words(name):
 
 
 def side_of(name):
-    """"L", "R" or None from the name: whole words left/right win, else the last lone l/r
+    """ "L", "R" or None from the name: whole words left/right win, else the last lone l/r
     ("r_toe.L" is a left rear toe)."""
     w = words(re.sub(r"\.\d+$", "", name))
     if "left" in w or "lft" in w:
@@ -47,8 +134,10 @@ def side_of(name):
 
 
 def end_of(name):
-    """"F" (fore), "H" (hind) or None when the name does not name a leg bone."""
-    w = set(words(name)) - {"l", "r", "left", "right"} | ({"f"} if re.match(r"f[._]", name.lower()) else set())
+    """ "F" (fore), "H" (hind) or None when the name does not name a leg bone."""
+    w = set(words(name)) - {"l", "r", "left", "right"} | (
+        {"f"} if re.match(r"f[._]", name.lower()) else set()
+    )
     if not w & _EXPLICIT and w & _NOT_LEG:
         return None
     if w & _FORE:
@@ -134,7 +223,10 @@ def find_legs_from_feet(armature, foot_names):
             chain.append(chain[-1].parent)
         chain.reverse()
         side = abs(float((tips[i] - centre) @ lateral))
-        while len(chain) > 2 and abs(float((np.array(chain[0].head_local) - centre) @ lateral)) < 0.3 * side:
+        while (
+            len(chain) > 2
+            and abs(float((np.array(chain[0].head_local) - centre) @ lateral)) < 0.3 * side
+        ):
             chain.pop(0)  # a girdle bone from the mid-plane (Rigify's pelvis.L)
         chains.append(chain[-6:])
     along = tips @ forward

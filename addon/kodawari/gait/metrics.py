@@ -77,22 +77,35 @@ def swing_smoothness(feet, contacts, leg, lo, hi, fps):
             neighbours = np.maximum(padded[:-2], padded[2:])
             jump = max(jump, float((steps - neighbours).max()))
             ratio = max(ratio, float((steps / np.maximum(neighbours, 1e-3)).max()))
-            accel = max(accel, float(np.linalg.norm(np.diff(path, 2, axis=0), axis=1).max() * fps * fps))
+            accel = max(
+                accel, float(np.linalg.norm(np.diff(path, 2, axis=0), axis=1).max() * fps * fps)
+            )
         f = g
     return jump, ratio, accel
 
 
-def measure(feet, roots, headings, contacts, gait, angles, limit_min, limit_max, neutral, reach, fps):
+def measure(
+    feet, roots, headings, contacts, gait, angles, limit_min, limit_max, neutral, reach, fps
+):
     """The criteria per gait segment, as a JSON-ready dict."""
     feet = np.asarray(feet, dtype=float)
     roots = np.asarray(roots, dtype=float)
     contacts = np.asarray(contacts, dtype=float)
-    offsets = fore_aft(feet, roots, np.asarray(headings, dtype=float), np.asarray(neutral, dtype=float))
-    outside = (angles < limit_min[None, :] - LIMIT_TOLERANCE) | (angles > limit_max[None, :] + LIMIT_TOLERANCE)
+    offsets = fore_aft(
+        feet, roots, np.asarray(headings, dtype=float), np.asarray(neutral, dtype=float)
+    )
+    outside = (angles < limit_min[None, :] - LIMIT_TOLERANCE) | (
+        angles > limit_max[None, :] + LIMIT_TOLERANCE
+    )
     result = []
     for g, lo, hi in segments(gait):
-        seg = {"gait": GAITS[g], "frame_start": lo, "frame_end": hi - 1, "seconds": (hi - lo) / fps,
-               "legs": {}}
+        seg = {
+            "gait": GAITS[g],
+            "frame_start": lo,
+            "frame_end": hi - 1,
+            "seconds": (hi - lo) / fps,
+            "legs": {},
+        }
         lh_lifts = [x for x in events(contacts, 2)[0] if lo <= x < hi]
         cycle = float(np.mean(np.diff(lh_lifts))) if len(lh_lifts) >= 2 else None
         seg["cycle_time"] = cycle / fps if cycle else None
@@ -116,16 +129,25 @@ def measure(feet, roots, headings, contacts, gait, angles, limit_min, limit_max,
                     # circular mean, so phases near 0 and 1 average correctly
                     angle = np.angle(np.mean(np.exp(2j * np.pi * np.array(phases))))
                     entry["phase"] = float((angle / (2 * np.pi)) % 1.0)
-                strides = [np.linalg.norm(feet[d2, leg] - feet[d1, leg])
-                           for d1, d2 in zip(downs[:-1], downs[1:]) if lo <= d1 and d2 < hi]
+                strides = [
+                    np.linalg.norm(feet[d2, leg] - feet[d1, leg])
+                    for d1, d2 in zip(downs[:-1], downs[1:])
+                    if lo <= d1 and d2 < hi
+                ]
                 if strides:
                     entry["stride"] = float(np.mean(strides))
             seg["legs"][name] = entry
         seg["joint_limit_violations"] = int(outside[lo:hi].sum())
         seg["largest_stance_slide"] = max(e["largest_stance_slide"] for e in seg["legs"].values())
         seg["largest_swing_jump"] = max(e["largest_swing_jump"] for e in seg["legs"].values())
-        seg["largest_swing_jump_ratio"] = max(e["largest_swing_jump_ratio"] for e in seg["legs"].values())
-        seg["largest_swing_acceleration"] = max(e["largest_swing_acceleration"] for e in seg["legs"].values())
-        seg["largest_foot_root_distance"] = max(e["largest_foot_root_distance"] for e in seg["legs"].values())
+        seg["largest_swing_jump_ratio"] = max(
+            e["largest_swing_jump_ratio"] for e in seg["legs"].values()
+        )
+        seg["largest_swing_acceleration"] = max(
+            e["largest_swing_acceleration"] for e in seg["legs"].values()
+        )
+        seg["largest_foot_root_distance"] = max(
+            e["largest_foot_root_distance"] for e in seg["legs"].values()
+        )
         result.append(seg)
     return result

@@ -25,14 +25,40 @@ class KODAWARI_OT_gait_setup(bpy.types.Operator):
     bl_options = {"REGISTER", "UNDO"}
 
     limits: bpy.props.EnumProperty(
-        name="Joint Ranges", default="REST", description="How far each leg joint may bend",
-        items=(("REST", "From Rest Pose", "Each joint bends the way it bends at rest, within a range around it"),
-               ("HORSE", "Horse", "A horse's joint ranges for 4-bone legs (other legs: from the rest pose)")))
+        name="Joint Ranges",
+        default="REST",
+        description="How far each leg joint may bend",
+        items=(
+            (
+                "REST",
+                "From Rest Pose",
+                "Each joint bends the way it bends at rest, within a range around it",
+            ),
+            (
+                "HORSE",
+                "Horse",
+                "A horse's joint ranges for 4-bone legs (other legs: from the rest pose)",
+            ),
+        ),
+    )
     root_motion: bpy.props.EnumProperty(
-        name="Root Motion", default="AUTO", description="Where the bake keys the animal's travel",
-        items=(("AUTO", "Automatic", "The body bone when the legs share one, else the armature object"),
-               ("BONE", "Body Bone", "The topmost bone carrying the legs whose location Blender applies"),
-               ("OBJECT", "Armature Object", "The armature object itself")))
+        name="Root Motion",
+        default="AUTO",
+        description="Where the bake keys the animal's travel",
+        items=(
+            (
+                "AUTO",
+                "Automatic",
+                "The body bone when the legs share one, else the armature object",
+            ),
+            (
+                "BONE",
+                "Body Bone",
+                "The topmost bone carrying the legs whose location Blender applies",
+            ),
+            ("OBJECT", "Armature Object", "The armature object itself"),
+        ),
+    )
 
     def execute(self, context):
         obj = _armature(context)
@@ -55,49 +81,75 @@ class KODAWARI_OT_gait_setup(bpy.types.Operator):
     def _setup(self, context, obj):
         """Everything is checked before anything is written: returns why not, or None."""
         armature = obj.data
-        selected = [pb.name for pb in (context.selected_pose_bones or [])] if context.mode == "POSE" else []
+        selected = (
+            [pb.name for pb in (context.selected_pose_bones or [])]
+            if context.mode == "POSE"
+            else []
+        )
         if len(selected) == 4:
             rigmod.gait_frame(obj)
-            legs, how = rigmod.find_legs_from_feet(armature, selected), "from the four selected feet"
+            legs, how = (
+                rigmod.find_legs_from_feet(armature, selected),
+                "from the four selected feet",
+            )
         else:
             legs, how = rigmod.find_legs_by_name(armature), "by name"
         missing = [k for k in LEG_NAMES if k not in legs]
         if missing:
             found = ", ".join(f"{k} ({len(v)} bones)" for k, v in legs.items()) or "none"
-            return (f"Found fewer than four legs {how}: found {found}; missing {', '.join(missing)}. "
-                    "Name leg bones with a side (.L/.R, _l/_r, Left/Right, 'L ') and a limb (thigh, shin, foot, "
-                    "upper_arm, forearm, hand, or fore/hind), or select the four foot bones in Pose Mode")
+            return (
+                f"Found fewer than four legs {how}: found {found}; missing {', '.join(missing)}. "
+                "Name leg bones with a side (.L/.R, _l/_r, Left/Right, 'L ') and a limb (thigh, shin, foot, "
+                "upper_arm, forearm, hand, or fore/hind), or select the four foot bones in Pose Mode"
+            )
         for k in LEG_NAMES:
             if len(legs[k]) < 2:
-                return (f"Leg {k} ('{legs[k][0]}') has a single bone; a leg needs 2 to 6 bones "
-                        "(a bone from the body to the foot cannot bend)")
+                return (
+                    f"Leg {k} ('{legs[k][0]}') has a single bone; a leg needs 2 to 6 bones "
+                    "(a bone from the body to the foot cannot bend)"
+                )
             if len(legs[k]) > 6:
-                return f"Leg {k} has {len(legs[k])} bones ({' > '.join(legs[k])}); a leg needs 2 to 6"
+                return (
+                    f"Leg {k} has {len(legs[k])} bones ({' > '.join(legs[k])}); a leg needs 2 to 6"
+                )
         body = rigmod.find_body(armature, legs)
         root_motion = self.root_motion
         if root_motion == "AUTO":
             root_motion = "BONE" if body is not None else "OBJECT"
         if root_motion == "BONE" and body is None:
-            return ("No body bone: the four legs have no common parent bone to carry root motion "
-                    "(use Root Motion: Armature Object)")
+            return (
+                "No body bone: the four legs have no common parent bone to carry root motion "
+                "(use Root Motion: Armature Object)"
+            )
         # Validate the geometry before touching the settings.
         forward = rigmod.forward_of(obj, legs)
         probe = {"forward": forward, "body_head": np.zeros(3), "body_rest": np.eye(3), "legs": []}
         ground = min(float(rigmod.leg_points(obj, legs[k])[1][2]) for k in LEG_NAMES)
         for k in LEG_NAMES:
             heads, tail = rigmod.leg_points(obj, legs[k])
-            probe["legs"].append({"heads": heads, "tail": tail, "limit_min": np.full(len(heads), -1.0),
-                                  "limit_max": np.full(len(heads), 1.0), "stiffness": np.ones(len(heads))})
+            probe["legs"].append(
+                {
+                    "heads": heads,
+                    "tail": tail,
+                    "limit_min": np.full(len(heads), -1.0),
+                    "limit_max": np.full(len(heads), 1.0),
+                    "stiffness": np.ones(len(heads)),
+                }
+            )
             d = np.diff(np.vstack([heads, tail[None, :]]), axis=0)
             planar = float(np.hypot(d @ forward, d[:, 2]).sum())
             drop = float(heads[0][2]) - ground
             if drop > planar * 0.999:
-                return (f"Leg {k} cannot reach the ground: its root '{legs[k][0]}' is {drop:.3g} m above the "
-                        f"lowest foot but the leg is only {planar:.3g} m long")
+                return (
+                    f"Leg {k} cannot reach the ground: its root '{legs[k][0]}' is {drop:.3g} m above the "
+                    f"lowest foot but the leg is only {planar:.3g} m long"
+                )
         why = native.module().gait_validate_rig(probe)
         if why:
             return f"The legs cannot be solved: {why}"
-        rigmod.fill_defaults(obj.kodawari_gait, obj, legs, body, preset=self.limits, root_motion=root_motion)
+        rigmod.fill_defaults(
+            obj.kodawari_gait, obj, legs, body, preset=self.limits, root_motion=root_motion
+        )
         summary = "; ".join(f"{k}: {' > '.join(legs[k])}" for k in LEG_NAMES)
         where = f"body bone '{body}'" if root_motion == "BONE" else "the armature object"
         self.report({"INFO"}, f"Found 4 legs {how}; root motion on {where}. {summary}")
@@ -130,8 +182,12 @@ class KODAWARI_OT_gait_report(bpy.types.Operator):
     bl_label = "Gait Report"
     bl_options = {"REGISTER", "UNDO"}
 
-    filepath: bpy.props.StringProperty(name="File Path", subtype="FILE_PATH", default="//gait_report.png",
-                                        description="Where to write the report")
+    filepath: bpy.props.StringProperty(
+        name="File Path",
+        subtype="FILE_PATH",
+        default="//gait_report.png",
+        description="Where to write the report",
+    )
 
     def execute(self, context):
         obj = _armature(context)

@@ -2,16 +2,18 @@
 split labels with keyframe decorators, the everyday settings on top, and the rig, the
 gait table and the legs in sub-panels that start closed."""
 
-# bl_options sets are Blender's class-attribute convention, never mutated.
-# ruff: noqa: RUF012
-
 import bpy
 
 from .. import in_use
 from .props import GAIT_ITEMS, LEG_NAMES
 
 GAIT_LABELS = {identifier: label for identifier, label, _ in GAIT_ITEMS}
-LEG_LABELS = {"LF": "Left Fore Leg", "RF": "Right Fore Leg", "LH": "Left Hind Leg", "RH": "Right Hind Leg"}
+LEG_LABELS = {
+    "LF": "Left Fore Leg",
+    "RF": "Right Fore Leg",
+    "LH": "Left Hind Leg",
+    "RH": "Right Hind Leg",
+}
 
 
 def _split(layout):
@@ -94,7 +96,10 @@ def _gait_row_panel(name):
 
         @classmethod
         def poll(cls, context):
-            return in_use.gait(context.object) and _entry(context.object.kodawari_gait, name) is not None
+            return (
+                in_use.gait(context.object)
+                and _entry(context.object.kodawari_gait, name) is not None
+            )
 
         def draw_header(self, context):
             self.layout.prop(_entry(context.object.kodawari_gait, name), "use_in_auto", text="")
@@ -147,7 +152,9 @@ def _leg_panel(name):
 
         @classmethod
         def poll(cls, context):
-            return in_use.gait(context.object) and _leg(context.object.kodawari_gait, name) is not None
+            return (
+                in_use.gait(context.object) and _leg(context.object.kodawari_gait, name) is not None
+            )
 
         def draw(self, context):
             layout = _split(self.layout)
@@ -166,9 +173,24 @@ GAIT_ROW_PANELS = tuple(_gait_row_panel(identifier) for identifier, _, _ in GAIT
 LEG_PANELS = tuple(_leg_panel(name) for name in LEG_NAMES)
 
 # Parents before children.
-KODAWARI_PT_gait_add = in_use.add_panel("KODAWARI_PT_gait_add", "Kodawari Gait", "object", in_use.can_rig,
-                                         in_use.gait, "kodawari.gait_setup", "Set Up Gait (find legs)", "ANIM")
+KODAWARI_PT_gait_add = in_use.add_panel(
+    "KODAWARI_PT_gait_add",
+    "Kodawari Gait",
+    "object",
+    in_use.can_rig,
+    in_use.gait,
+    "kodawari.gait_setup",
+    "Set Up Gait (find legs)",
+    "ANIM",
+)
 
 
-CLASSES = (KODAWARI_PT_gait_add, KODAWARI_PT_gait, KODAWARI_PT_gait_rig, KODAWARI_PT_gait_table, *GAIT_ROW_PANELS,
-           KODAWARI_PT_gait_legs, *LEG_PANELS)
+CLASSES = (
+    KODAWARI_PT_gait_add,
+    KODAWARI_PT_gait,
+    KODAWARI_PT_gait_rig,
+    KODAWARI_PT_gait_table,
+    *GAIT_ROW_PANELS,
+    KODAWARI_PT_gait_legs,
+    *LEG_PANELS,
+)

@@ -16,8 +16,12 @@ from .font import draw_text
 from .props import LEG_NAMES
 
 GAIT_COLORS = {  # soft backgrounds per gait segment
-    0: (0.86, 0.93, 0.86, 1), 1: (0.86, 0.90, 0.98, 1), 2: (0.98, 0.93, 0.84, 1),
-    3: (0.98, 0.86, 0.86, 1), 4: (0.93, 0.86, 0.98, 1)}
+    0: (0.86, 0.93, 0.86, 1),
+    1: (0.86, 0.90, 0.98, 1),
+    2: (0.98, 0.93, 0.84, 1),
+    3: (0.98, 0.86, 0.86, 1),
+    4: (0.93, 0.86, 0.98, 1),
+}
 LEG_COLORS = ((0.85, 0.2, 0.1, 1), (0.95, 0.6, 0.1, 1), (0.1, 0.35, 0.85, 1), (0.1, 0.65, 0.6, 1))
 
 
@@ -39,7 +43,9 @@ def read_baked(obj):
     contacts = [_curve(action, obj, f'["{p}"]') for p in CONTACT_PROPS]
     gait = _curve(action, obj, f'["{GAIT_PROP}"]')
     if any(c is None for c in contacts) or gait is None:
-        raise ValueError(f"'{obj.name}' has no gait bake (no kodawari_contact_* channels): bake the gait first")
+        raise ValueError(
+            f"'{obj.name}' has no gait bake (no kodawari_contact_* channels): bake the gait first"
+        )
     frames = gait[0]
     n = len(frames)
     axes = rigmod.hinge_axes(obj, chains, rig["forward"])
@@ -62,18 +68,28 @@ def read_baked(obj):
             q = np.stack(q, axis=1)
             # Hinge angle back from the quaternion (w, axis * sin(a/2)).
             angles.append(2 * np.arctan2(q[:, 1:] @ axes[name], q[:, 0]))
-    data = {"rig": rig, "chains": chains, "frames": frames,
-            "angles": np.ascontiguousarray(np.stack(angles, axis=1)),
-            "contacts": np.stack([c[1] for c in contacts], axis=1).astype(np.float64),
-            "gait": np.round(gait[1]).astype(int)}
+    data = {
+        "rig": rig,
+        "chains": chains,
+        "frames": frames,
+        "angles": np.ascontiguousarray(np.stack(angles, axis=1)),
+        "contacts": np.stack([c[1] for c in contacts], axis=1).astype(np.float64),
+        "gait": np.round(gait[1]).astype(int),
+    }
     if not rig["on_object"]:
         body = settings.body_bone
         loc = [_curve(action, obj, f'pose.bones["{body}"].location', i) for i in range(3)]
-        rot = [_curve(action, obj, f'pose.bones["{body}"].rotation_quaternion', i) for i in range(4)]
+        rot = [
+            _curve(action, obj, f'pose.bones["{body}"].rotation_quaternion', i) for i in range(4)
+        ]
         if any(c is None for c in loc + rot):
             raise ValueError(f"the body bone '{body}' has no baked motion: bake the gait again")
-        data["body_location"] = np.ascontiguousarray(np.stack([c[1] for c in loc], axis=1), dtype=np.float64)
-        data["body_rotation"] = np.ascontiguousarray(np.stack([c[1] for c in rot], axis=1), dtype=np.float64)
+        data["body_location"] = np.ascontiguousarray(
+            np.stack([c[1] for c in loc], axis=1), dtype=np.float64
+        )
+        data["body_rotation"] = np.ascontiguousarray(
+            np.stack([c[1] for c in rot], axis=1), dtype=np.float64
+        )
     return data
 
 
@@ -120,10 +136,14 @@ def headings_of(rig, body_rotation):
     rest = rig["body_rest"]
     q = body_rotation / np.linalg.norm(body_rotation, axis=1, keepdims=True)
     w, x, y, z = q.T
-    m = np.stack([
-        np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)], axis=1),
-        np.stack([2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)], axis=1),
-        np.stack([2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)], axis=1)], axis=1)
+    m = np.stack(
+        [
+            np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)], axis=1),
+            np.stack([2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)], axis=1),
+            np.stack([2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)], axis=1),
+        ],
+        axis=1,
+    )
     world = np.einsum("ij,fjk,kl->fil", rest, m, rest.T)
     h = world @ rig["forward"]
     h[:, 2] = 0
@@ -141,8 +161,19 @@ def measure_baked(obj, fps, scene=None):
     limit_max = np.concatenate([leg["limit_max"] for leg in rig["legs"]])
     reach = np.array([rig_reach(rig, k) for k in range(4)])
     headings = headings_from_roots(roots)
-    segs = metrics.measure(feet, roots, headings, data["contacts"], data["gait"], data["angles"], limit_min,
-                           limit_max, rigmod.neutral_offsets(rig), reach, fps)
+    segs = metrics.measure(
+        feet,
+        roots,
+        headings,
+        data["contacts"],
+        data["gait"],
+        data["angles"],
+        limit_min,
+        limit_max,
+        rigmod.neutral_offsets(rig),
+        reach,
+        fps,
+    )
     data.update(feet=feet, roots=roots, headings=headings, segments=segs, reach=reach)
     return data
 
@@ -185,22 +216,28 @@ def draw_report(data, fps, width=1400):
     # gait segments behind both plots, with their names
     for g, lo, hi in metrics.segments(gait):
         x0, x1 = int(xs[lo]), int(xs[hi - 1]) + 1
-        img[top:top + foot_h, x0:x1] = GAIT_COLORS[g]
-        img[traj_top:traj_top + traj_h, x0:x1] = GAIT_COLORS[g]
+        img[top : top + foot_h, x0:x1] = GAIT_COLORS[g]
+        img[traj_top : traj_top + traj_h, x0:x1] = GAIT_COLORS[g]
         if x1 - x0 > 40:
-            draw_text(img, x0 + 3, top - 14, metrics.GAITS[g].replace("GALLOP_ROTARY", "ROTARY"), black, 1)
+            draw_text(
+                img, x0 + 3, top - 14, metrics.GAITS[g].replace("GALLOP_ROTARY", "ROTARY"), black, 1
+            )
     draw_text(img, left, 8, "FOOTFALLS (HILDEBRAND): BLACK = PLANTED", black, 2)
     for row, leg in enumerate((2, 0, 1, 3)):  # LH, LF, RF, RH
         y = top + row * row_h
         draw_text(img, 10, y + 6, metrics.LEGS[leg], black, 2)
         planted = contacts[:, leg] > 0.5
         for f in np.flatnonzero(planted):
-            img[y + 4:y + row_h - 4, int(xs[f]):int(xs[min(f + 1, n - 1)]) + 1] = black
+            img[y + 4 : y + row_h - 4, int(xs[f]) : int(xs[min(f + 1, n - 1)]) + 1] = black
     # fore-aft trajectories relative to each leg's root (seed figures 4.7, 4.8)
     lim = float(max(reach.max(), np.abs(offsets).max())) * 1.1
+
     def ypix(v):
         return traj_top + traj_h / 2 - v / lim * (traj_h / 2)
-    draw_text(img, left, traj_top - 34, "FORE-AFT FOOT POSITION FROM LEG ROOT (M), +- REACH", black, 2)
+
+    draw_text(
+        img, left, traj_top - 34, "FORE-AFT FOOT POSITION FROM LEG ROOT (M), +- REACH", black, 2
+    )
     _line(img, left, ypix(0), left + plot_w, ypix(0), (0.5, 0.5, 0.5, 1))
     for leg in range(4):
         for sign in (1, -1):
@@ -209,8 +246,18 @@ def draw_report(data, fps, width=1400):
                 _line(img, x, yl, min(x + 6, left + plot_w), yl, LEG_COLORS[leg])
     for leg in range(4):
         for f in range(n - 1):
-            _line(img, xs[f], ypix(offsets[f, leg]), xs[f + 1], ypix(offsets[f + 1, leg]), LEG_COLORS[leg], 2)
-        draw_text(img, left + 10 + leg * 60, traj_top + traj_h + 10, metrics.LEGS[leg], LEG_COLORS[leg], 2)
+            _line(
+                img,
+                xs[f],
+                ypix(offsets[f, leg]),
+                xs[f + 1],
+                ypix(offsets[f + 1, leg]),
+                LEG_COLORS[leg],
+                2,
+            )
+        draw_text(
+            img, left + 10 + leg * 60, traj_top + traj_h + 10, metrics.LEGS[leg], LEG_COLORS[leg], 2
+        )
     for v in (-lim / 1.1, 0.0, lim / 1.1):
         draw_text(img, 4, int(ypix(v)) - 4, f"{v:+.1f}", black, 1)
     seconds = n / fps
@@ -239,9 +286,14 @@ def write_report(obj, filepath, fps):
     directory = os.path.dirname(base)
     if directory:
         os.makedirs(directory, exist_ok=True)
-    report = {"object": obj.name, "fps": fps, "frame_start": float(data["frames"][0]),
-              "frame_end": float(data["frames"][-1]), "reach": [float(r) for r in data["reach"]],
-              "segments": data["segments"]}
+    report = {
+        "object": obj.name,
+        "fps": fps,
+        "frame_start": float(data["frames"][0]),
+        "frame_end": float(data["frames"][-1]),
+        "reach": [float(r) for r in data["reach"]],
+        "segments": data["segments"],
+    }
     with open(base + ".json", "w") as fh:
         json.dump(report, fh, indent=1)
     save_png(draw_report(data, fps), base + ".png")  # a quick look in Blender's Image Editor

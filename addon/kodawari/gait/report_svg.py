@@ -13,8 +13,13 @@ import numpy as np
 
 from . import metrics
 
-GAIT_NAMES = {"WALK": "Walk", "TROT": "Trot", "CANTER": "Canter", "GALLOP": "Gallop",
-              "GALLOP_ROTARY": "Rotary gallop"}
+GAIT_NAMES = {
+    "WALK": "Walk",
+    "TROT": "Trot",
+    "CANTER": "Canter",
+    "GALLOP": "Gallop",
+    "GALLOP_ROTARY": "Rotary gallop",
+}
 GAIT_FILLS = ("#dcefdc", "#dce6fa", "#faedd6", "#fadcdc", "#eddcfa")
 LEG_NAMES = {"LF": "Left fore", "RF": "Right fore", "LH": "Left hind", "RH": "Right hind"}
 LEG_STROKES = ("#d9331a", "#f29919", "#1a59d9", "#1aa699")  # LF, RF, LH, RH
@@ -35,16 +40,20 @@ def _ticks(span, target=8):
 
 def _text(x, y, text, size=13, anchor="start", weight="normal", fill="#1a1a1a", rotate=None):
     transform = f' transform="rotate({rotate} {x:.1f} {y:.1f})"' if rotate is not None else ""
-    return (f'<text x="{x:.1f}" y="{y:.1f}" font-size="{size}" text-anchor="{anchor}" font-weight="{weight}" '
-            f'fill="{fill}"{transform}>{escape(text)}</text>')
+    return (
+        f'<text x="{x:.1f}" y="{y:.1f}" font-size="{size}" text-anchor="{anchor}" font-weight="{weight}" '
+        f'fill="{fill}"{transform}>{escape(text)}</text>'
+    )
 
 
 def _polyline(xs, ys, stroke, width=1.6, dash=None):
     buffer = io.StringIO()
     np.savetxt(buffer, np.column_stack([xs, ys]), fmt="%.1f,%.1f", newline=" ")
     dashes = f' stroke-dasharray="{dash}"' if dash else ""
-    return (f'<polyline points="{buffer.getvalue().strip()}" fill="none" stroke="{stroke}" '
-            f'stroke-width="{width}"{dashes}/>')
+    return (
+        f'<polyline points="{buffer.getvalue().strip()}" fill="none" stroke="{stroke}" '
+        f'stroke-width="{width}"{dashes}/>'
+    )
 
 
 def _runs(mask):
@@ -72,38 +81,66 @@ def render(data, fps, title="Gait report"):
         return TRAJ_TOP + TRAJ_H / 2 - np.asarray(v) / lim * (TRAJ_H / 2)
 
     foot_h = 4 * ROW_H
-    out = [(f'<svg xmlns="http://www.w3.org/2000/svg" viewBox="0 0 {WIDTH} {HEIGHT}" width="{WIDTH}" '
-            f'height="{HEIGHT}" font-family="DejaVu Sans, Helvetica, Arial, sans-serif">'),
-           f'<rect width="{WIDTH}" height="{HEIGHT}" fill="white"/>',
-           _text(LEFT, 28, title, size=18, weight="bold")]
+    out = [
+        (
+            f'<svg xmlns="http://www.w3.org/2000/svg" viewBox="0 0 {WIDTH} {HEIGHT}" width="{WIDTH}" '
+            f'height="{HEIGHT}" font-family="DejaVu Sans, Helvetica, Arial, sans-serif">'
+        ),
+        f'<rect width="{WIDTH}" height="{HEIGHT}" fill="white"/>',
+        _text(LEFT, 28, title, size=18, weight="bold"),
+    ]
     # Gait segments: coloured bands behind both plots, named above the footfalls.
     for g, lo, hi in metrics.segments(gait):
         x0, x1 = x_of(lo / fps), x_of(min(hi, n - 1) / fps if hi < n else duration)
         for top, h in ((FOOT_TOP, foot_h), (TRAJ_TOP, TRAJ_H)):
-            out.append(f'<rect x="{x0:.1f}" y="{top}" width="{max(x1 - x0, 0.5):.1f}" height="{h}" '
-                       f'fill="{GAIT_FILLS[g]}"/>')
+            out.append(
+                f'<rect x="{x0:.1f}" y="{top}" width="{max(x1 - x0, 0.5):.1f}" height="{h}" '
+                f'fill="{GAIT_FILLS[g]}"/>'
+            )
         if x1 - x0 > 45:
-            out.append(_text((x0 + x1) / 2, FOOT_TOP - 8, GAIT_NAMES[metrics.GAITS[g]], size=12, anchor="middle"))
+            out.append(
+                _text(
+                    (x0 + x1) / 2,
+                    FOOT_TOP - 8,
+                    GAIT_NAMES[metrics.GAITS[g]],
+                    size=12,
+                    anchor="middle",
+                )
+            )
     # Footfalls.
-    out.append(_text(LEFT, 54, "Footfalls (Hildebrand diagram): a bar while the foot is planted", size=14))
+    out.append(
+        _text(LEFT, 54, "Footfalls (Hildebrand diagram): a bar while the foot is planted", size=14)
+    )
     for row, leg in enumerate(ROW_ORDER):
         y = FOOT_TOP + row * ROW_H
-        out.append(_text(LEFT - 8, y + ROW_H * 0.65, LEG_NAMES[metrics.LEGS[leg]], size=12, anchor="end"))
+        out.append(
+            _text(LEFT - 8, y + ROW_H * 0.65, LEG_NAMES[metrics.LEGS[leg]], size=12, anchor="end")
+        )
         for lo, hi in _runs(contacts[:, leg] > 0.5):
             x0, x1 = x_of(lo / fps), x_of(hi / fps)
-            out.append(f'<rect x="{x0:.1f}" y="{y + 4}" width="{max(x1 - x0, 0.5):.1f}" height="{ROW_H - 8}" '
-                       f'fill="#1a1a1a"/>')
-    out.append(f'<rect x="{LEFT}" y="{FOOT_TOP}" width="{plot_w}" height="{foot_h}" fill="none" stroke="#555"/>')
+            out.append(
+                f'<rect x="{x0:.1f}" y="{y + 4}" width="{max(x1 - x0, 0.5):.1f}" height="{ROW_H - 8}" '
+                f'fill="#1a1a1a"/>'
+            )
+    out.append(
+        f'<rect x="{LEFT}" y="{FOOT_TOP}" width="{plot_w}" height="{foot_h}" fill="none" stroke="#555"/>'
+    )
     # Fore-aft trajectories with their reach limits.
     out.append(_text(LEFT, TRAJ_TOP - 14, "Fore-aft foot position from its leg root", size=14))
-    out.append(f'<line x1="{LEFT}" x2="{LEFT + plot_w}" y1="{y_of(0):.1f}" y2="{y_of(0):.1f}" stroke="#888"/>')
+    out.append(
+        f'<line x1="{LEFT}" x2="{LEFT + plot_w}" y1="{y_of(0):.1f}" y2="{y_of(0):.1f}" stroke="#888"/>'
+    )
     for leg in range(4):
         for sign in (1, -1):
             level = float(y_of(sign * reach[leg]))
-            out.append(_polyline([LEFT, LEFT + plot_w], [level, level], LEG_STROKES[leg], 1.0, "6 5"))
+            out.append(
+                _polyline([LEFT, LEFT + plot_w], [level, level], LEG_STROKES[leg], 1.0, "6 5")
+            )
     for leg in range(4):
         out.append(_polyline(x_of(seconds), y_of(offsets[:, leg]), LEG_STROKES[leg]))
-    out.append(f'<rect x="{LEFT}" y="{TRAJ_TOP}" width="{plot_w}" height="{TRAJ_H}" fill="none" stroke="#555"/>')
+    out.append(
+        f'<rect x="{LEFT}" y="{TRAJ_TOP}" width="{plot_w}" height="{TRAJ_H}" fill="none" stroke="#555"/>'
+    )
     # Axes: value ticks in metres, time ticks in seconds under both plots.
     step = _ticks(2 * lim, 6)
     for value in np.arange(-np.floor(lim / step) * step, lim + 1e-9, step):
@@ -111,15 +148,27 @@ def render(data, fps, title="Gait report"):
         out.append(f'<line x1="{LEFT - 5}" x2="{LEFT}" y1="{y:.1f}" y2="{y:.1f}" stroke="#555"/>')
         label = "0" if abs(value) < step * 1e-6 else f"{value:+.2f}"
         out.append(_text(LEFT - 8, y + 4, label, size=11, anchor="end"))
-    out.append(_text(40, TRAJ_TOP + TRAJ_H / 2, "Fore-aft position (m), + ahead", size=13, anchor="middle",
-                     rotate=-90))
+    out.append(
+        _text(
+            40,
+            TRAJ_TOP + TRAJ_H / 2,
+            "Fore-aft position (m), + ahead",
+            size=13,
+            anchor="middle",
+            rotate=-90,
+        )
+    )
     step = _ticks(duration, 10)
     for t in np.arange(0.0, duration + 1e-9, step):
         x = float(x_of(t))
         for bottom in (FOOT_TOP + foot_h, TRAJ_TOP + TRAJ_H):
-            out.append(f'<line x1="{x:.1f}" x2="{x:.1f}" y1="{bottom}" y2="{bottom + 5}" stroke="#555"/>')
+            out.append(
+                f'<line x1="{x:.1f}" x2="{x:.1f}" y1="{bottom}" y2="{bottom + 5}" stroke="#555"/>'
+            )
         out.append(_text(x, TRAJ_TOP + TRAJ_H + 19, f"{t:g}", size=11, anchor="middle"))
-    out.append(_text(LEFT + plot_w / 2, TRAJ_TOP + TRAJ_H + 40, "Time (s)", size=13, anchor="middle"))
+    out.append(
+        _text(LEFT + plot_w / 2, TRAJ_TOP + TRAJ_H + 40, "Time (s)", size=13, anchor="middle")
+    )
     # Legend.
     y = HEIGHT - 30
     x = LEFT
@@ -135,7 +184,9 @@ def render(data, fps, title="Gait report"):
     # The gait bands' colours (a short segment has no room for its name).
     y, x = HEIGHT - 55, LEFT
     for g in sorted({g for g, _, _ in metrics.segments(gait)}):
-        out.append(f'<rect x="{x}" y="{y - 11}" width="26" height="12" fill="{GAIT_FILLS[g]}" stroke="#999"/>')
+        out.append(
+            f'<rect x="{x}" y="{y - 11}" width="26" height="12" fill="{GAIT_FILLS[g]}" stroke="#999"/>'
+        )
         out.append(_text(x + 32, y, GAIT_NAMES[metrics.GAITS[g]], size=12))
         x += 120
     out.append("</svg>")

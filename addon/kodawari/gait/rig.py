@@ -62,8 +62,10 @@ def gait_frame(obj):
     m = mat3(placement(obj))
     scales = np.linalg.norm(m, axis=0)
     if not np.all(scales > 1e-9) or scales.max() - scales.min() > 1e-4 * scales.max():
-        raise ValueError(f"'{obj.name}' has a non-uniform scale ({', '.join(f'{v:.3g}' for v in scales)}): "
-                         "apply the scale (Ctrl+A > Scale) first")
+        raise ValueError(
+            f"'{obj.name}' has a non-uniform scale ({', '.join(f'{v:.3g}' for v in scales)}): "
+            "apply the scale (Ctrl+A > Scale) first"
+        )
     if np.linalg.det(m) < 0:
         raise ValueError(f"'{obj.name}' has a negative (mirroring) scale: apply the scale first")
     return m, float(scales.mean())
@@ -169,13 +171,21 @@ def leg_stiffness(n, fore, rest, lengths=None):
 
 
 def _leg_stiffness(n, fore, rest):
-    base = np.interp(np.linspace(0, 1, n), np.linspace(0, 1, 4), HORSE_STIFFNESS) if n > 1 else np.ones(1)
+    base = (
+        np.interp(np.linspace(0, 1, n), np.linspace(0, 1, 4), HORSE_STIFFNESS)
+        if n > 1
+        else np.ones(1)
+    )
     if fore or n < 2:
         return [float(v) for v in base]
     femur = 1 if n >= 4 and abs(rest[0]) > 45.0 else 0
     out = [float(v) for v in base]
     out[femur] = 1.0
-    below = np.interp(np.linspace(0, 1, n - femur - 1), np.linspace(0, 1, 3), (0.3, 0.5, 0.7)) if n - femur > 1 else []
+    below = (
+        np.interp(np.linspace(0, 1, n - femur - 1), np.linspace(0, 1, 3), (0.3, 0.5, 0.7))
+        if n - femur > 1
+        else []
+    )
     for i, v in enumerate(below):
         out[femur + 1 + i] = float(v)
     for i in range(femur):
@@ -242,8 +252,12 @@ def table_dict(settings):
         if entry is None:
             raise ValueError(f"the gait table has no {name} row: run Gait Setup")
         rows.append([float(getattr(entry, c)) for c in kn.GAIT_COLUMNS])
-    return {"gaits": np.array(rows, dtype=np.float64), "use_froude": bool(settings.use_froude),
-            "hysteresis": float(settings.hysteresis), "reach": float(settings.reach)}
+    return {
+        "gaits": np.array(rows, dtype=np.float64),
+        "use_froude": bool(settings.use_froude),
+        "hysteresis": float(settings.hysteresis),
+        "reach": float(settings.reach),
+    }
 
 
 def rig_dict(obj, settings):
@@ -264,17 +278,25 @@ def rig_dict(obj, settings):
         legs[leg.name] = leg
     missing = [k for k in LEG_NAMES if k not in legs]
     if missing:
-        raise ValueError(f"fewer than four legs set up (missing {', '.join(missing)}): run Gait Setup")
+        raise ValueError(
+            f"fewer than four legs set up (missing {', '.join(missing)}): run Gait Setup"
+        )
     on_object = settings.root_motion == "OBJECT"
     if not on_object and settings.body_bone not in armature.bones:
-        raise ValueError("no body bone set (the bone carrying root motion): run Gait Setup, "
-                         "or set Root Motion to Armature Object")
+        raise ValueError(
+            "no body bone set (the bone carrying root motion): run Gait Setup, "
+            "or set Root Motion to Armature Object"
+        )
     if not on_object and armature.bones[settings.body_bone].use_connect:
-        raise ValueError(f"the body bone '{settings.body_bone}' is connected to its parent, so Blender ignores "
-                         "its location keys: choose an unconnected bone or Root Motion: Armature Object")
+        raise ValueError(
+            f"the body bone '{settings.body_bone}' is connected to its parent, so Blender ignores "
+            "its location keys: choose an unconnected bone or Root Motion: Armature Object"
+        )
     if on_object and obj.parent is not None:
-        raise ValueError(f"'{obj.name}' has a parent: root motion on the object needs an unparented armature "
-                         "(or use Root Motion: Body Bone)")
+        raise ValueError(
+            f"'{obj.name}' has a parent: root motion on the object needs an unparented armature "
+            "(or use Root Motion: Body Bone)"
+        )
     m, scale = gait_frame(obj)
     chains = {k: [b.name for b in legs[k].bones] for k in LEG_NAMES}
     forward = forward_of(obj, chains)
@@ -285,17 +307,27 @@ def rig_dict(obj, settings):
         body = armature.bones[settings.body_bone]
         head = _points(obj, [body.name], "head_local")[0]
         rest = (m / scale) @ mat3(body.matrix_local.to_3x3().normalized())
-    rig = {"forward": forward, "body_head": head, "body_rest": rest, "legs": [],
-           "reach_fraction": float(settings.reach), "frame": m, "scale": scale, "on_object": on_object}
+    rig = {
+        "forward": forward,
+        "body_head": head,
+        "body_rest": rest,
+        "legs": [],
+        "reach_fraction": float(settings.reach),
+        "frame": m,
+        "scale": scale,
+        "on_object": on_object,
+    }
     for k in LEG_NAMES:
         heads, tail = leg_points(obj, chains[k])
-        rig["legs"].append({
-            "heads": np.ascontiguousarray(heads),
-            "tail": np.ascontiguousarray(tail),
-            "limit_min": np.radians([b.limit_min for b in legs[k].bones]).astype(np.float64),
-            "limit_max": np.radians([b.limit_max for b in legs[k].bones]).astype(np.float64),
-            "stiffness": np.array([b.stiffness for b in legs[k].bones], dtype=np.float64),
-        })
+        rig["legs"].append(
+            {
+                "heads": np.ascontiguousarray(heads),
+                "tail": np.ascontiguousarray(tail),
+                "limit_min": np.radians([b.limit_min for b in legs[k].bones]).astype(np.float64),
+                "limit_max": np.radians([b.limit_max for b in legs[k].bones]).astype(np.float64),
+                "stiffness": np.array([b.stiffness for b in legs[k].bones], dtype=np.float64),
+            }
+        )
     why = native.module().gait_validate_rig(rig)
     if why:
         raise ValueError(why)
@@ -323,7 +355,9 @@ def leg_length(rig):
 
 
 def neutral_offsets(rig):
-    return np.array([float((leg["tail"] - leg["heads"][0]) @ rig["forward"]) for leg in rig["legs"]])
+    return np.array(
+        [float((leg["tail"] - leg["heads"][0]) @ rig["forward"]) for leg in rig["legs"]]
+    )
 
 
 def hinge_channel(axis):

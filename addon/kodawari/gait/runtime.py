@@ -8,7 +8,11 @@ _last = {}
 
 def remember(obj, job):
     _last[obj.as_pointer()] = {
-        "frames": job.frames, "fps": job.fps, "result": job.result, "rig": job.rig, "chains": job.chains
+        "frames": job.frames,
+        "fps": job.fps,
+        "result": job.result,
+        "rig": job.rig,
+        "chains": job.chains,
     }
 
 

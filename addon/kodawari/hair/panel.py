@@ -2,9 +2,6 @@
 Blender's layout: the rod list on top, the active rod's settings, its keys and the
 colliders in sub-panels, the solver quality closed by default."""
 
-# bl_options sets are Blender's class-attribute convention, never mutated.
-# ruff: noqa: RUF012
-
 import bpy
 from bpy.app.translations import pgettext_iface as iface_
 
@@ -88,7 +85,9 @@ class KODAWARI_PT_hair(_HairPanel, bpy.types.Panel):
         problem = problem or problems.message(obj, "hair")
         if problem:
             layout.label(text=problem, icon="ERROR", translate=False)
-        layout.template_list("KODAWARI_UL_hair_rods", "", settings, "rods", settings, "active_rod", rows=3)
+        layout.template_list(
+            "KODAWARI_UL_hair_rods", "", settings, "rods", settings, "active_rod", rows=3
+        )
         row = layout.row(align=True)
         row.operator("kodawari.rod_add", text="Add Rod", icon="ADD")
         row.operator("kodawari.rod_remove", text="Remove Rod", icon="REMOVE")
@@ -175,8 +174,15 @@ class KODAWARI_PT_hair_colliders(_HairPanel, bpy.types.Panel):
         obj = context.object
         settings = obj.kodawari_hair
         row = layout.row()
-        row.template_list("KODAWARI_UL_hair_colliders", "", settings, "colliders", settings, "active_collider",
-                          rows=2)
+        row.template_list(
+            "KODAWARI_UL_hair_colliders",
+            "",
+            settings,
+            "colliders",
+            settings,
+            "active_collider",
+            rows=2,
+        )
         col = row.column(align=True)
         col.operator("kodawari.rod_collider_add", icon="ADD", text="")
         col.operator("kodawari.rod_collider_remove", icon="REMOVE", text="")
@@ -191,10 +197,26 @@ class KODAWARI_PT_hair_colliders(_HairPanel, bpy.types.Panel):
             col.prop(collider, "offset")
 
 
-KODAWARI_PT_hair_add = in_use.add_panel("KODAWARI_PT_hair_add", "Kodawari Hair", "data", in_use.can_rig,
-                                         in_use.hair, "kodawari.rod_add", "Add Hair Rod (selected bones)", "STRANDS")
+KODAWARI_PT_hair_add = in_use.add_panel(
+    "KODAWARI_PT_hair_add",
+    "Kodawari Hair",
+    "data",
+    in_use.can_rig,
+    in_use.hair,
+    "kodawari.rod_add",
+    "Add Hair Rod (selected bones)",
+    "STRANDS",
+)
 
 
-CLASSES = (KODAWARI_UL_hair_rods, KODAWARI_UL_hair_keys, KODAWARI_UL_hair_colliders, KODAWARI_PT_hair_add,
-           KODAWARI_PT_hair,
-           KODAWARI_PT_hair_rod, KODAWARI_PT_hair_rod_quality, KODAWARI_PT_hair_keys, KODAWARI_PT_hair_colliders)
+CLASSES = (
+    KODAWARI_UL_hair_rods,
+    KODAWARI_UL_hair_keys,
+    KODAWARI_UL_hair_colliders,
+    KODAWARI_PT_hair_add,
+    KODAWARI_PT_hair,
+    KODAWARI_PT_hair_rod,
+    KODAWARI_PT_hair_rod_quality,
+    KODAWARI_PT_hair_keys,
+    KODAWARI_PT_hair_colliders,
+)

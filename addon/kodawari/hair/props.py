@@ -168,8 +168,11 @@ class KodawariHairRod(bpy.types.PropertyGroup):
     )
     # Identity of the rod, also stored on its root pose bone (chains.ROD_ID_PROPERTY): a
     # custom property travels with the bone through renames, so the rod finds it again.
-    uid: bpy.props.StringProperty(name="Rod ID", options={"HIDDEN"},
-                                  description="Identifies the rod when its root bone is renamed")
+    uid: bpy.props.StringProperty(
+        name="Rod ID",
+        options={"HIDDEN"},
+        description="Identifies the rod when its root bone is renamed",
+    )
 
 
 class KodawariHairCollider(bpy.types.PropertyGroup):

@@ -307,7 +307,9 @@ def get(obj, build=True):
     """The runtime of an armature object, built (or rebuilt after a change) on demand."""
     key = obj.as_pointer()
     rt = _runtimes.get(key)
-    if rt is not None and (rt.data_pointer != obj.data.as_pointer() or rt.bone_count != len(obj.pose.bones)):
+    if rt is not None and (
+        rt.data_pointer != obj.data.as_pointer() or rt.bone_count != len(obj.pose.bones)
+    ):
         rt = None  # another armature at a freed object's address, or bones added/removed: rebuild
     if rt is None and build:
         rt = ArmatureRuntime(obj)

@@ -13,8 +13,10 @@ CONTEXTS = ("*", "Operator")
 
 
 def dictionary():
-    return {locale: {(context, msgid): text for msgid, text in strings.items() for context in CONTEXTS}
-            for locale, strings in LANGUAGES.items()}
+    return {
+        locale: {(context, msgid): text for msgid, text in strings.items() for context in CONTEXTS}
+        for locale, strings in LANGUAGES.items()
+    }
 
 
 def msgids():

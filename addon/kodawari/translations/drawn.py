@@ -9,7 +9,14 @@ import ast
 import os
 
 PACKAGE = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-UI_FILES = ("menus.py", "sidebar.py", "fish/panel.py", "hair/panel.py", "gait/panel.py", "fish/apply.py")
+UI_FILES = (
+    "menus.py",
+    "sidebar.py",
+    "fish/panel.py",
+    "hair/panel.py",
+    "gait/panel.py",
+    "fish/apply.py",
+)
 TEXT_CALLS = {"iface_", "pgettext_iface", "pgettext", "tip_", "_count"}
 
 
@@ -18,7 +25,11 @@ def _literals(tree):
         if not isinstance(node, ast.Call):
             continue
         for keyword in node.keywords:
-            if keyword.arg == "text" and isinstance(keyword.value, ast.Constant) and keyword.value.value:
+            if (
+                keyword.arg == "text"
+                and isinstance(keyword.value, ast.Constant)
+                and keyword.value.value
+            ):
                 yield keyword.value.value
         name = getattr(node.func, "id", None) or getattr(node.func, "attr", None)
         if name in TEXT_CALLS:

@@ -40,7 +40,9 @@ def _property_strings(owner, prop):
     if prop.type == "ENUM":
         for item in prop.enum_items:
             yield UIString(owner, f"{prop.identifier}[{item.identifier}].name", item.name)
-            yield UIString(owner, f"{prop.identifier}[{item.identifier}].description", item.description)
+            yield UIString(
+                owner, f"{prop.identifier}[{item.identifier}].description", item.description
+            )
 
 
 def walk(classes):
