@@ -15,8 +15,10 @@ catfish-like), eel, cetacean (dolphin, horizontal flukes, a beak), shark.
 
 import math
 
+import bpy  # first: puts Blender's own modules on sys.path
+
+# isort: split
 import bmesh
-import bpy
 import numpy as np
 
 # w, h: half width / half height at the widest point; peak: where; ped: peduncle half size.

@@ -4,8 +4,10 @@ Run it under throw-away BLENDER_USER_* folders (tools/*.sh do) so nothing leaks.
 
 import os
 
-import addon_utils
 import bpy  # first: importing bpy puts Blender's own modules (addon_utils) on sys.path
+
+# isort: split
+import addon_utils
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 ADDON_ZIP = os.environ.get("KODAWARI_ADDON_ZIP", os.path.join(ROOT, "dist", "kodawari.zip"))

@@ -5,8 +5,10 @@ import subprocess
 import sys
 import textwrap
 
-import addon_utils
 import bpy  # first: importing bpy puts Blender's own modules (addon_utils) on sys.path
+
+# isort: split
+import addon_utils
 import pytest
 from conftest import ADDON_ZIP
 

@@ -1,7 +1,9 @@
 """Edits to a swimming mesh are followed, not silently undone (issue 10 items 3, 4)."""
 
+import bpy  # first: puts Blender's own modules on sys.path
+
+# isort: split
 import bmesh
-import bpy
 import numpy as np
 from fish_helpers import activate, add_swim, live, make_fish, rest, set_fps
 
