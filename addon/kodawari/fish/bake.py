@@ -11,6 +11,7 @@ import struct
 
 import bpy
 import numpy as np
+from bpy.app.translations import pgettext_tip as tip_
 
 from .. import cache_paths, editable, fcurves
 from ..bake_job import BakeError, BakeJob
@@ -67,7 +68,9 @@ class SwimBakeJob(BakeJob):
         if why:
             raise BakeError(why)
         if obj.kodawari_swim.baked != "NONE":
-            raise BakeError(f"'{obj.name}' is already baked: Free Bake first to bake again")
+            raise BakeError(
+                tip_("'{}' is already baked: Free Bake first to bake again").format(obj.name)
+            )
         # Every binding input checked before a frame is baked (a deleted fin group fails here).
         runtime.get_rig(obj)
         if obj.kodawari_swim.speed_mode != "NONE":

@@ -3,6 +3,7 @@ gait_report (measure the baked Action, write PNG + JSON)."""
 
 import bpy
 import numpy as np
+from bpy.app.translations import pgettext_tip as tip_
 
 from .. import editable, native
 from ..bake_job import BakeError, BakeOperator, frame_range
@@ -63,7 +64,7 @@ class KODAWARI_OT_gait_setup(bpy.types.Operator):
     def execute(self, context):
         obj = _armature(context)
         if obj is None:
-            self.report({"ERROR"}, "Gait Setup needs an armature as the active object")
+            self.report({"ERROR"}, tip_("Gait Setup needs an armature as the active object"))
             return {"CANCELLED"}
         why = editable.why_not(obj, "get a gait")
         if why:
@@ -152,7 +153,9 @@ class KODAWARI_OT_gait_setup(bpy.types.Operator):
         )
         summary = "; ".join(f"{k}: {' > '.join(legs[k])}" for k in LEG_NAMES)
         where = f"body bone '{body}'" if root_motion == "BONE" else "the armature object"
-        self.report({"INFO"}, f"Found 4 legs {how}; root motion on {where}. {summary}")
+        self.report(
+            {"INFO"}, tip_("Found 4 legs {}; root motion on {}. {}").format(how, where, summary)
+        )
         return None
 
 
@@ -172,7 +175,7 @@ class KODAWARI_OT_gait_bake(BakeOperator, bpy.types.Operator):
         try:
             return GaitBakeJob(context, obj, start, end)
         except ValueError as exc:
-            raise BakeError(f"Gait bake: {exc}") from None
+            raise BakeError(tip_("Gait bake: {}").format(exc)) from None
 
 
 class KODAWARI_OT_gait_report(bpy.types.Operator):
@@ -192,18 +195,18 @@ class KODAWARI_OT_gait_report(bpy.types.Operator):
     def execute(self, context):
         obj = _armature(context)
         if obj is None:
-            self.report({"ERROR"}, "Gait Report needs an armature as the active object")
+            self.report({"ERROR"}, tip_("Gait Report needs an armature as the active object"))
             return {"CANCELLED"}
         if not self.filepath:
-            self.report({"ERROR"}, "Gait Report needs a file path")
+            self.report({"ERROR"}, tip_("Gait Report needs a file path"))
             return {"CANCELLED"}
         scene = context.scene
         try:
             png, js, _ = write_report(obj, self.filepath, scene.render.fps / scene.render.fps_base)
         except (ValueError, OSError) as exc:
-            self.report({"ERROR"}, f"Gait report: {exc}")
+            self.report({"ERROR"}, tip_("Gait report: {}").format(exc))
             return {"CANCELLED"}
-        self.report({"INFO"}, f"Wrote {png} and {js}")
+        self.report({"INFO"}, tip_("Wrote {} and {}").format(png, js))
         return {"FINISHED"}
 
     def invoke(self, context, event):

@@ -5,6 +5,7 @@ simulation is switched off for the bake and everything it touched is put back.""
 
 import bpy
 import numpy as np
+from bpy.app.translations import pgettext_tip as tip_
 
 from .. import editable, fcurves
 from ..bake_job import BakeError, BakeJob
@@ -36,7 +37,7 @@ class HairBakeJob(BakeJob):
             raise BakeError(why)
         settings = obj.kodawari_hair
         if not len(settings.rods):
-            raise BakeError("This armature has no rods to bake")
+            raise BakeError(tip_("This armature has no rods to bake"))
         self.rt = runtime.ArmatureRuntime(obj)  # validates every rod before anything changes
         if self.rt.error:
             raise BakeError(self.rt.error)

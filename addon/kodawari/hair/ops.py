@@ -4,6 +4,7 @@ nothing when it refuses (a clear report, {'CANCELLED'})."""
 import math
 
 import bpy
+from bpy.app.translations import pgettext_tip as tip_
 from mathutils import Vector
 
 from .. import editable
@@ -171,7 +172,7 @@ class KODAWARI_OT_rod_add(_HairOperator, bpy.types.Operator):
         context.scene.render.use_lock_interface = True
         names = [r.name for r, _ in plans]
         shown = ", ".join(names[:8]) + (f" and {len(names) - 8} more" if len(names) > 8 else "")
-        self.report({"INFO"}, f"Added {len(plans)} rod(s): {shown}")
+        self.report({"INFO"}, tip_("Added {} rod(s): {}").format(len(plans), shown))
         return {"FINISHED"}
 
 
@@ -193,7 +194,7 @@ class KODAWARI_OT_rod_remove(_HairOperator, bpy.types.Operator):
         settings.rods.remove(index)
         settings.active_rod = max(0, min(settings.active_rod, len(settings.rods) - 1))
         runtime.invalidate(obj)
-        self.report({"INFO"}, f"Removed rod '{name}'")
+        self.report({"INFO"}, tip_("Removed rod '{}'").format(name))
         return {"FINISHED"}
 
 
@@ -234,7 +235,7 @@ class KODAWARI_OT_rod_key_view(_HairOperator, bpy.types.Operator):
         key.direction = direction
         key.influence = self.influence
         runtime.invalidate(obj)
-        self.report({"INFO"}, f"Keyed '{key.name}' on rod '{rod.root_bone}'")
+        self.report({"INFO"}, tip_("Keyed '{}' on rod '{}'").format(key.name, rod.root_bone))
         return {"FINISHED"}
 
 
@@ -279,7 +280,7 @@ class KODAWARI_OT_rod_key_pose(_HairOperator, bpy.types.Operator):
         key.rotation = rotation
         key.influence = self.influence
         runtime.invalidate(obj)
-        self.report({"INFO"}, f"Keyed '{key.name}' on rod '{rod.root_bone}'")
+        self.report({"INFO"}, tip_("Keyed '{}' on rod '{}'").format(key.name, rod.root_bone))
         return {"FINISHED"}
 
 
@@ -318,7 +319,10 @@ class KODAWARI_OT_rod_key_speed(_HairOperator, bpy.types.Operator):
         key.speed = self.speed
         key.influence = self.influence
         runtime.invalidate(obj)
-        self.report({"INFO"}, f"Keyed '{key.name}' at {self.speed:g} m/s on rod '{rod.root_bone}'")
+        self.report(
+            {"INFO"},
+            tip_("Keyed '{}' at {:g} m/s on rod '{}'").format(key.name, self.speed, rod.root_bone),
+        )
         return {"FINISHED"}
 
 
@@ -354,7 +358,7 @@ class KODAWARI_OT_rod_key_preview(_HairOperator, bpy.types.Operator):
         for pb, joint in zip(chain, key.shape):
             pb.rotation_mode = "QUATERNION"
             pb.rotation_quaternion = joint.rotation
-        self.report({"INFO"}, f"Chain '{rod.root_bone}' shows key '{key.name}'")
+        self.report({"INFO"}, tip_("Chain '{}' shows key '{}'").format(rod.root_bone, key.name))
         return {"FINISHED"}
 
 
@@ -381,7 +385,7 @@ class KODAWARI_OT_rod_rekey(_HairOperator, bpy.types.Operator):
         for q in shape:
             key.shape.add().rotation = q
         runtime.invalidate(obj)
-        self.report({"INFO"}, f"Re-keyed '{key.name}'")
+        self.report({"INFO"}, tip_("Re-keyed '{}'").format(key.name))
         return {"FINISHED"}
 
 
@@ -406,7 +410,7 @@ class KODAWARI_OT_rod_key_remove(_HairOperator, bpy.types.Operator):
         rod.keys.remove(i)
         rod.active_key = max(0, min(rod.active_key, len(rod.keys) - 1))
         runtime.invalidate(obj)
-        self.report({"INFO"}, f"Deleted key '{name}'")
+        self.report({"INFO"}, tip_("Deleted key '{}'").format(name))
         return {"FINISHED"}
 
 
@@ -527,7 +531,9 @@ class KODAWARI_OT_rod_fit_stroke(_HairOperator, bpy.types.Operator):
         for pb, q in zip(chain, rotations):
             pb.rotation_mode = "QUATERNION"
             pb.rotation_quaternion = q
-        self.report({"INFO"}, f"Chain '{rod.root_bone}' fitted to the {origin} stroke")
+        self.report(
+            {"INFO"}, tip_("Chain '{}' fitted to the {} stroke").format(rod.root_bone, origin)
+        )
         return {"FINISHED"}
 
 
