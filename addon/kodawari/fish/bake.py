@@ -31,7 +31,7 @@ def read_pc2(path):
     with open(path, "rb") as handle:
         magic, version, points, start, rate, samples = struct.unpack("<12siiffi", handle.read(32))
         if magic != b"POINTCACHE2\0" or version != 1:
-            raise ValueError(f"{path} is not a PC2 point cache")
+            raise ValueError(tip_("{} is not a PC2 point cache").format(path))
         data = np.frombuffer(handle.read(), dtype="<f4")
     return start, rate, data.reshape(samples, points, 3)
 
