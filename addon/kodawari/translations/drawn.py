@@ -74,8 +74,8 @@ def sources():
 
 
 def reports():
-    """The literal first argument of every tip_("...") call in the add-on: the report and
-    error messages (operators' reports, bake errors, problems said once)."""
+    """The literal first argument of every tip_("...") call in the add-on (the report and
+    error messages: operators' reports, bake errors, problems said once) and bake job titles."""
     found = set()
     for path in sources():
         for node in ast.walk(_parse(path)):
@@ -89,6 +89,14 @@ def reports():
                     and first.value
                 ):
                     found.add(first.value)
+            # A bake job's `title = "..."` is said through tip_(job.title) in its reports.
+            if (
+                isinstance(node, ast.Assign)
+                and getattr(node.targets[0], "id", "") == "title"
+                and isinstance(node.value, ast.Constant)
+                and isinstance(node.value.value, str)
+            ):
+                found.add(node.value.value)
     return found
 
 
