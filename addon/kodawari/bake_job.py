@@ -141,7 +141,7 @@ def running_bakes():
 
 
 def status_text(job, fraction):
-    return f"{job.title}: {int(fraction * 100)}%   Esc cancels"
+    return tip_("{}: {}%   Esc cancels").format(tip_(job.title), int(fraction * 100))
 
 
 class BakeOperator:

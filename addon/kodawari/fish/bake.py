@@ -64,7 +64,7 @@ class SwimBakeJob(BakeJob):
 
     def prepare(self):
         obj = self.obj
-        why = editable.why_not(obj, "bake its swim")
+        why = editable.why_not(obj, tip_("bake its swim"))
         if why:
             raise BakeError(why)
         if obj.kodawari_swim.baked != "NONE":
@@ -183,8 +183,14 @@ class SwimBakeJob(BakeJob):
             settings.enabled = self.was_enabled
         self.was_enabled = None
         self._restore_frame()
-        where = f"to {self.filepath}" if self.target == "MESH_CACHE" else "to shape keys"
-        return f"Baked {len(self.frames)} frames of '{obj.name}' {where}; live evaluation is off"
+        where = (
+            tip_("to {}").format(self.filepath)
+            if self.target == "MESH_CACHE"
+            else tip_("to shape keys")
+        )
+        return tip_("Baked {} frames of '{}' {}; live evaluation is off").format(
+            len(self.frames), obj.name, where
+        )
 
 
 def free_bake(obj):

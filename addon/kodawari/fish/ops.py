@@ -62,7 +62,7 @@ class KODAWARI_OT_swim_add(bpy.types.Operator):
             error = f"'{obj.name}' already swims: tune it in the Modifier tab, or remove it first"
         else:
             error = (
-                editable.why_not(obj, "swim")
+                editable.why_not(obj, tip_("swim"))
                 or validate.swim_target(obj)
                 or validate.frequency(self.frequency)
             )
@@ -168,7 +168,7 @@ class KODAWARI_OT_swim_remove(bpy.types.Operator):
         ):
             self.report({"ERROR"}, tip_("'{}' has no Fish Swim to remove").format(obj.name))
             return {"CANCELLED"}
-        error = editable.why_not(obj, "lose its swim")
+        error = editable.why_not(obj, tip_("lose its swim"))
         if error:
             self.report({"ERROR"}, error)
             return {"CANCELLED"}
@@ -214,7 +214,7 @@ def _check_fin(obj, group_name, kind, known_weights=None, reach=None):
             )
         fin_setup.build_parts(0, trial, weights, rig.rest, rig.axis_rest, rig.up, kn, reach)
     except ValueError as exc:
-        return f"Cannot bind fin '{group_name}': {exc}", None
+        return tip_("Cannot bind fin '{}': {}").format(group_name, exc), None
     return None, weights
 
 
@@ -240,8 +240,8 @@ def _needs_swim(obj):
     if obj is None or obj.type != "MESH":
         return tip_("Select the swimming mesh object first")
     if runtime.swim_key_block(obj) is None:  # hidden in the viewport (enabled off) still swims
-        return f"'{obj.name}' does not swim yet: Add Fish Swim first"
-    return editable.why_not(obj, "change its swim")
+        return tip_("'{}' does not swim yet: Add Fish Swim first").format(obj.name)
+    return editable.why_not(obj, tip_("change its swim"))
 
 
 class KODAWARI_OT_swim_fin_add(bpy.types.Operator):
@@ -493,7 +493,7 @@ class KODAWARI_OT_swim_free_bake(bpy.types.Operator):
         if obj is None or obj.type != "MESH" or obj.kodawari_swim.baked == "NONE":
             self.report({"ERROR"}, tip_("Select a fish with a baked swim first"))
             return {"CANCELLED"}
-        error = editable.why_not(obj, "free its bake")
+        error = editable.why_not(obj, tip_("free its bake"))
         if error:
             self.report({"ERROR"}, error)
             return {"CANCELLED"}

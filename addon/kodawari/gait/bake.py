@@ -395,7 +395,7 @@ class GaitBakeJob(BakeJob):
             self.action.name = name
         runtime.remember(self.obj, self)
         self.obj.update_tag()
-        return f"Baked {len(self.frames)} frames of gait on '{self.obj.name}'"
+        return tip_("Baked {} frames of gait on '{}'").format(len(self.frames), self.obj.name)
 
     def cancel(self):
         """Put back the action, slot, rotation modes and custom properties."""

@@ -32,7 +32,7 @@ class HairBakeJob(BakeJob):
 
     def prepare(self):
         obj, scene = self.obj, self.scene
-        why = editable.why_not(obj, "bake its hair")
+        why = editable.why_not(obj, tip_("bake its hair"))
         if why:
             raise BakeError(why)
         settings = obj.kodawari_hair
@@ -122,11 +122,14 @@ class HairBakeJob(BakeJob):
         obj.kodawari_hair.enabled = False
         self.scene.frame_set(snap["frame"][0], subframe=snap["frame"][1])
         self.snapshot = None
-        return (
-            f"Baked {len(self.chains)} bones over frames {self.start}-{self.end} into action "
-            f"'{action.name}'"
-            + (" (NLA track)" if self.new_action else "")
-            + "; live simulation turned off"
+        return tip_(
+            "Baked {} bones over frames {}-{} into action '{}'{}; live simulation turned off"
+        ).format(
+            len(self.chains),
+            self.start,
+            self.end,
+            action.name,
+            tip_(" (NLA track)") if self.new_action else "",
         )
 
     def _write(self, action, frames, values):

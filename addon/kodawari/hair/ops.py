@@ -21,7 +21,7 @@ def _armature(context):
     obj = context.active_object
     if obj is None or obj.type != "ARMATURE":
         raise _Refusal(tip_("Select an armature: the active object is not an armature"))
-    why = editable.why_not(obj, "change its hair")
+    why = editable.why_not(obj, tip_("change its hair"))
     if why:
         raise _Refusal(why)
     return obj
