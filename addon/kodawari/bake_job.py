@@ -18,6 +18,7 @@ import time
 import traceback
 
 import bpy
+from bpy.app.translations import pgettext_tip as tip_
 from bpy.props import IntProperty
 
 from . import problems
@@ -53,7 +54,9 @@ def frame_range(operator, scene):
     end = operator.frame_end if props.is_property_set("frame_end") else scene.frame_end
     if end < start:
         raise BakeError(
-            f"End frame {end} is before start frame {start}: set an end at or after the start"
+            tip_("End frame {} is before start frame {}: set an end at or after the start").format(
+                end, start
+            )
         )
     operator.frame_start, operator.frame_end = start, end
     return start, end
@@ -65,14 +68,14 @@ def failure_message(job, exc):
         return str(exc)
     if isinstance(exc, OSError) and exc.strerror:
         where = f" '{exc.filename}'" if exc.filename else ""
-        return f"{job.title} failed and was undone: {exc.strerror}{where}"
+        return tip_("{} failed and was undone: {}{}").format(tip_(job.title), exc.strerror, where)
     if not isinstance(exc, (ValueError, KeyError, AttributeError, IndexError, RuntimeError)):
         traceback.print_exc()  # an unexpected failure: the console keeps the details for a bug report
     try:  # the creature's own words for what broke (a deleted fin group, an empty path...)
         detail = problems.describe(job.obj, exc)
     except Exception:  # noqa: BLE001 - a job without an object, or the object is gone
         detail = f"{type(exc).__name__}: {exc}"
-    return f"{job.title} failed and was undone: {detail}"
+    return tip_("{} failed and was undone: {}").format(tip_(job.title), detail)
 
 
 def cancel_quietly(job):
@@ -138,7 +141,7 @@ def running_bakes():
 
 
 def status_text(job, fraction):
-    return f"{job.title}: {int(fraction * 100)}%   Esc cancels"
+    return tip_("{}: {}%   Esc cancels").format(tip_(job.title), int(fraction * 100))
 
 
 class BakeOperator:
@@ -200,7 +203,9 @@ class BakeOperator:
         if event.type == "ESC":
             self._end(context)
             cancel_quietly(job)
-            self.report({"WARNING"}, f"{job.title} cancelled: nothing was changed")
+            self.report(
+                {"WARNING"}, tip_("{} cancelled: nothing was changed").format(tip_(job.title))
+            )
             return {"CANCELLED"}
         if event.type != "TIMER":
             return {"PASS_THROUGH"} if event.type in NAVIGATION_EVENTS else {"RUNNING_MODAL"}

@@ -9,6 +9,7 @@ the user is asked to save first. Every check runs before the first frame is bake
 import os
 
 import bpy
+from bpy.app.translations import pgettext_tip as tip_
 
 from .bake_job import BakeError
 
@@ -21,7 +22,7 @@ SAVE_FIRST = "Save the file first: caches are written beside the .blend, in a fo
 def blend_folder():
     """`//blendcache_<name>/` of the open file (Blender's point-cache folder convention)."""
     if not bpy.data.filepath:
-        raise BakeError(SAVE_FIRST)
+        raise BakeError(tip_(SAVE_FIRST))
     stem = os.path.splitext(os.path.basename(bpy.data.filepath))[0]
     return f"//{FOLDER_PREFIX}{stem}/"
 
@@ -56,21 +57,25 @@ def default_path(obj, suffix, extension):
 def check_target(obj, path):
     """The absolute file a bake of obj may write `path` to; BakeError says why not."""
     if path.startswith("//") and not bpy.data.filepath:
-        raise BakeError(f"{SAVE_FIRST} ('{path}' is relative to it)")
+        raise BakeError(tip_("{} ('{}' is relative to it)").format(tip_(SAVE_FIRST), path))
     target = _absolute(path)
     if path.endswith(("/", "\\")) or os.path.isdir(target):
         raise BakeError(
-            f"'{path}' is a folder: give a file name, such as {bpy.path.clean_name(obj.name)}.pc2"
+            tip_("'{}' is a folder: give a file name, such as {}.pc2").format(
+                path, bpy.path.clean_name(obj.name)
+            )
         )
     owner = caches_in_use(except_obj=obj).get(target)
     if owner is not None:
-        raise BakeError(f"'{path}' is the cache of '{owner}': choose another file")
+        raise BakeError(tip_("'{}' is the cache of '{}': choose another file").format(path, owner))
     folder = os.path.dirname(target)
     parent = folder
     while parent and not os.path.exists(parent):
         parent = os.path.dirname(parent)
     if parent and not os.path.isdir(parent):
-        raise BakeError(f"Cannot write '{path}': '{parent}' is a file, not a folder")
+        raise BakeError(
+            tip_("Cannot write '{}': '{}' is a file, not a folder").format(path, parent)
+        )
     return target
 
 
@@ -82,7 +87,9 @@ def open_partial(target):
         # Kept open across the bake's steps; closed by the job's finish() or cancel().
         return open(target + ".part", "wb")
     except OSError as exc:
-        raise BakeError(f"Cannot write the cache '{target}': {exc.strerror or exc}") from exc
+        raise BakeError(
+            tip_("Cannot write the cache '{}': {}").format(target, exc.strerror or exc)
+        ) from exc
 
 
 def discard_partial(handle, target):

@@ -12,6 +12,7 @@ import os
 import sys
 
 import bpy
+from bpy.app.translations import pgettext_tip as tip_
 
 from . import bake_job
 from .bake_job import BakeError
@@ -37,7 +38,9 @@ def _ensure_registered():
         from . import native
 
         raise BakeError(
-            f"Kodawari could not start: {native.error() or 'the add-on did not register'}"
+            tip_("Kodawari could not start: {}").format(
+                native.error() or tip_("the add-on did not register")
+            )
         )
 
 
@@ -85,7 +88,9 @@ def bake_all(save=True, exit_on_failure=None):
         _ensure_registered()
         if not bpy.data.filepath:
             raise BakeError(
-                "Save the file first: caches are written beside the .blend, in a folder named after it"
+                tip_(
+                    "Save the file first: caches are written beside the .blend, in a folder named after it"
+                )
             )
         done, failed = _bake_scenes()
         if save and done:
@@ -129,7 +134,7 @@ def _bake_scenes():
                 try:
                     job = make()
                 except ValueError as exc:  # a gait that cannot be solved refuses in its constructor
-                    raise BakeError(f"Gait bake: {exc}") from None
+                    raise BakeError(tip_("Gait bake: {}").format(exc)) from None
                 done.append(f"{scene.name}/{name}: {bake_job.run(job)}")
             except BakeError as exc:
                 failed.append(f"{scene.name}/{name}: {exc}")

@@ -1,6 +1,7 @@
 """Add-on preferences: says whether the compiled core loaded, and why not."""
 
 import bpy
+from bpy.app.translations import pgettext_tip as tip_
 
 from . import native
 
@@ -62,5 +63,5 @@ class KODAWARI_OT_native_report(bpy.types.Operator):
     bl_options = {"INTERNAL"}
 
     def execute(self, context):
-        self.report({"ERROR"}, native.error() or "Kodawari's compiled core did not load")
+        self.report({"ERROR"}, native.error() or tip_("Kodawari's compiled core did not load"))
         return {"CANCELLED"}

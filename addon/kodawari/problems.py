@@ -10,6 +10,7 @@ so the same message for the same object is said once.
 """
 
 import bpy
+from bpy.app.translations import pgettext_tip as tip_
 
 _messages = {}  # (feature, object name) -> the message shown in the panel
 _pending = []  # messages waiting for the report area (a timer shows them)
@@ -26,10 +27,10 @@ def describe(obj, exc):
     if swim is not None and getattr(obj, "type", "") == "MESH":
         missing = [f.vertex_group for f in swim.fins if f.vertex_group not in obj.vertex_groups]
         if missing:
-            return (
-                f"fin vertex group '{missing[0]}' is missing (deleted or renamed): "
+            return tip_(
+                "fin vertex group '{}' is missing (deleted or renamed): "
                 "rename it back, or remove the fin"
-            )
+            ).format(missing[0])
         for constraint in obj.constraints:
             target = getattr(constraint, "target", None)
             if (
@@ -38,12 +39,12 @@ def describe(obj, exc):
                 and target.type == "CURVE"
                 and not any(len(s.points) + len(s.bezier_points) for s in target.data.splines)
             ):
-                return (
-                    f"the Follow Path curve '{target.name}' has no points: draw the path, "
+                return tip_(
+                    "the Follow Path curve '{}' has no points: draw the path, "
                     "or remove the constraint"
-                )
+                ).format(target.name)
     if isinstance(exc, KeyError):
-        return f"'{exc.args[0] if exc.args else ''}' is missing (deleted or renamed?)"
+        return tip_("'{}' is missing (deleted or renamed?)").format(exc.args[0] if exc.args else "")
     text = str(exc)
     return text if isinstance(exc, ValueError) and text else f"{type(exc).__name__}: {text}"
 
@@ -59,7 +60,7 @@ def report(obj, feature, exc):
     if _messages.get(key) == message:
         return message
     _messages[key] = message
-    line = f"Kodawari {feature}: '{name}' stopped: {message}"
+    line = tip_("Kodawari {}: '{}' stopped: {}").format(feature, name, message)
     print(line)
     if not bpy.app.background:  # headless, the console is where the user looks
         _pending.append(line)

@@ -97,3 +97,14 @@ def test_reports_translate(empty_scene, japanese):
     make_fish("tuna")
     with pytest.raises(RuntimeError, match="適用する魚の泳ぎがありません"):
         bpy.ops.kodawari.swim_apply()
+
+
+def test_bake_and_remove_reports_translate(empty_scene, japanese, tmp_path):
+    """Reports built from a msgid with variable parts (tip_(...).format) and the bake's
+    refusals (BakeError) reach the report area in Japanese, names filled in."""
+    obj = make_fish("tuna")
+    with pytest.raises(RuntimeError, match=f"'{obj.name}' には削除する魚の泳ぎがありません"):
+        bpy.ops.kodawari.swim_remove()
+    add_swim(obj, head_axis="POS_X")
+    with pytest.raises(RuntimeError, match="終了フレーム 3 が開始フレーム 10 より前です"):
+        bpy.ops.kodawari.swim_bake(frame_start=10, frame_end=3, filepath=str(tmp_path / "x.pc2"))

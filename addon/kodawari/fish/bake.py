@@ -11,6 +11,7 @@ import struct
 
 import bpy
 import numpy as np
+from bpy.app.translations import pgettext_tip as tip_
 
 from .. import cache_paths, editable, fcurves
 from ..bake_job import BakeError, BakeJob
@@ -30,7 +31,7 @@ def read_pc2(path):
     with open(path, "rb") as handle:
         magic, version, points, start, rate, samples = struct.unpack("<12siiffi", handle.read(32))
         if magic != b"POINTCACHE2\0" or version != 1:
-            raise ValueError(f"{path} is not a PC2 point cache")
+            raise ValueError(tip_("{} is not a PC2 point cache").format(path))
         data = np.frombuffer(handle.read(), dtype="<f4")
     return start, rate, data.reshape(samples, points, 3)
 
@@ -63,11 +64,13 @@ class SwimBakeJob(BakeJob):
 
     def prepare(self):
         obj = self.obj
-        why = editable.why_not(obj, "bake its swim")
+        why = editable.why_not(obj, tip_("bake its swim"))
         if why:
             raise BakeError(why)
         if obj.kodawari_swim.baked != "NONE":
-            raise BakeError(f"'{obj.name}' is already baked: Free Bake first to bake again")
+            raise BakeError(
+                tip_("'{}' is already baked: Free Bake first to bake again").format(obj.name)
+            )
         # Every binding input checked before a frame is baked (a deleted fin group fails here).
         runtime.get_rig(obj)
         if obj.kodawari_swim.speed_mode != "NONE":
@@ -180,8 +183,14 @@ class SwimBakeJob(BakeJob):
             settings.enabled = self.was_enabled
         self.was_enabled = None
         self._restore_frame()
-        where = f"to {self.filepath}" if self.target == "MESH_CACHE" else "to shape keys"
-        return f"Baked {len(self.frames)} frames of '{obj.name}' {where}; live evaluation is off"
+        where = (
+            tip_("to {}").format(self.filepath)
+            if self.target == "MESH_CACHE"
+            else tip_("to shape keys")
+        )
+        return tip_("Baked {} frames of '{}' {}; live evaluation is off").format(
+            len(self.frames), obj.name, where
+        )
 
 
 def free_bake(obj):

@@ -10,6 +10,7 @@ turns the motion with the body's rotation at the fin root every frame.
 """
 
 import numpy as np
+from bpy.app.translations import pgettext_tip as tip_
 
 
 class FinPart:
@@ -119,7 +120,9 @@ def build_parts(fin_index, fin, group_weights, verts, body_axis, up, kn, reach_a
     """FinParts of one fin setting; raises ValueError with a readable reason."""
     indices = np.flatnonzero(group_weights > 0.0)
     if len(indices) < 4:
-        raise ValueError(f"vertex group '{fin.vertex_group}' has fewer than 4 vertices")
+        raise ValueError(
+            tip_("vertex group '{}' has fewer than 4 vertices").format(fin.vertex_group)
+        )
     points_all = verts[indices].astype(np.float64)
     parts = []
     centroid_all = points_all.mean(axis=0)
@@ -139,7 +142,9 @@ def build_parts(fin_index, fin, group_weights, verts, body_axis, up, kn, reach_a
             reach = (points - centroid) @ _outward(fin.kind, centroid - axis_point, frame)
         lo, hi = float(reach.min()), float(reach.max())
         if hi - lo < 1e-6:
-            raise ValueError(f"vertex group '{fin.vertex_group}' does not stand out from the body")
+            raise ValueError(
+                tip_("vertex group '{}' does not stand out from the body").format(fin.vertex_group)
+            )
         r = (reach - lo) / (hi - lo)  # 0 at the root, 1 at the fin's outer edge
         root = points[r <= 0.1].mean(axis=0)
         tip = points[r >= 0.9].mean(axis=0)
@@ -148,7 +153,9 @@ def build_parts(fin_index, fin, group_weights, verts, body_axis, up, kn, reach_a
         along = points @ frame[0]
         base = (float(along.min()), float(along.max()))
         if fin.motion == "UNDULATE" and base[1] - base[0] < 1e-6:
-            raise ValueError(f"vertex group '{fin.vertex_group}' has no length along the body")
+            raise ValueError(
+                tip_("vertex group '{}' has no length along the body").format(fin.vertex_group)
+            )
         # The motion fades in over the first root_blend of the fin (docs/algorithms.md
         # §2.5: the root must not move, or the fin tears from the body).
         # An undulation's sideways wave fades in over the whole fin height: over a short

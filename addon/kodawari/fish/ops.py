@@ -4,6 +4,7 @@ import types
 
 import bpy
 import numpy as np
+from bpy.app.translations import pgettext_tip as tip_
 from bpy.props import EnumProperty, FloatProperty, IntProperty, StringProperty
 
 from .. import bulk, cache_paths, editable, fcurves, native
@@ -61,7 +62,7 @@ class KODAWARI_OT_swim_add(bpy.types.Operator):
             error = f"'{obj.name}' already swims: tune it in the Modifier tab, or remove it first"
         else:
             error = (
-                editable.why_not(obj, "swim")
+                editable.why_not(obj, tip_("swim"))
                 or validate.swim_target(obj)
                 or validate.frequency(self.frequency)
             )
@@ -83,7 +84,9 @@ class KODAWARI_OT_swim_add(bpy.types.Operator):
         try:
             rig_module.SwimRig(obj, trial)
         except ValueError as exc:
-            self.report({"ERROR"}, f"Cannot bind '{obj.name}' to a swim axis: {exc}")
+            self.report(
+                {"ERROR"}, tip_("Cannot bind '{}' to a swim axis: {}").format(obj.name, exc)
+            )
             return {"CANCELLED"}
 
         settings = obj.kodawari_swim
@@ -107,7 +110,10 @@ class KODAWARI_OT_swim_add(bpy.types.Operator):
         runtime.forget(obj)
         runtime.evaluate(obj, context.scene)
         self.report(
-            {"INFO"}, f"Fish Swim on '{obj.name}': {guess}; preset {presets.LABELS[self.preset][0]}"
+            {"INFO"},
+            tip_("Fish Swim on '{}': {}; preset {}").format(
+                obj.name, guess, tip_(presets.LABELS[self.preset][0])
+            ),
         )
         return {"FINISHED"}
 
@@ -152,7 +158,7 @@ class KODAWARI_OT_swim_remove(bpy.types.Operator):
     def execute(self, context):
         obj = _active_mesh(context)
         if obj is None or obj.type != "MESH":
-            self.report({"ERROR"}, "Select the swimming mesh object first")
+            self.report({"ERROR"}, tip_("Select the swimming mesh object first"))
             return {"CANCELLED"}
         settings = obj.kodawari_swim
         if (
@@ -160,15 +166,17 @@ class KODAWARI_OT_swim_remove(bpy.types.Operator):
             and settings.baked == "NONE"
             and runtime.swim_key_block(obj) is None
         ):
-            self.report({"ERROR"}, f"'{obj.name}' has no Fish Swim to remove")
+            self.report({"ERROR"}, tip_("'{}' has no Fish Swim to remove").format(obj.name))
             return {"CANCELLED"}
-        error = editable.why_not(obj, "lose its swim")
+        error = editable.why_not(obj, tip_("lose its swim"))
         if error:
             self.report({"ERROR"}, error)
             return {"CANCELLED"}
         with runtime.batch(obj):
             remove_swim(obj)
-        self.report({"INFO"}, f"Fish Swim removed from '{obj.name}'; its mesh is as it was")
+        self.report(
+            {"INFO"}, tip_("Fish Swim removed from '{}'; its mesh is as it was").format(obj.name)
+        )
         return {"FINISHED"}
 
 
@@ -206,7 +214,7 @@ def _check_fin(obj, group_name, kind, known_weights=None, reach=None):
             )
         fin_setup.build_parts(0, trial, weights, rig.rest, rig.axis_rest, rig.up, kn, reach)
     except ValueError as exc:
-        return f"Cannot bind fin '{group_name}': {exc}", None
+        return tip_("Cannot bind fin '{}': {}").format(group_name, exc), None
     return None, weights
 
 
@@ -230,10 +238,10 @@ def add_fin(obj, group_name, kind, rebind=True):
 
 def _needs_swim(obj):
     if obj is None or obj.type != "MESH":
-        return "Select the swimming mesh object first"
+        return tip_("Select the swimming mesh object first")
     if runtime.swim_key_block(obj) is None:  # hidden in the viewport (enabled off) still swims
-        return f"'{obj.name}' does not swim yet: Add Fish Swim first"
-    return editable.why_not(obj, "change its swim")
+        return tip_("'{}' does not swim yet: Add Fish Swim first").format(obj.name)
+    return editable.why_not(obj, tip_("change its swim"))
 
 
 class KODAWARI_OT_swim_fin_add(bpy.types.Operator):
@@ -270,7 +278,10 @@ class KODAWARI_OT_swim_fin_add(bpy.types.Operator):
             return {"CANCELLED"}
         add_fin(obj, self.vertex_group, self.kind)
         self.report(
-            {"INFO"}, f"Fin '{self.vertex_group}' ({self.kind.lower()}) added to '{obj.name}'"
+            {"INFO"},
+            tip_("Fin '{}' ({}) added to '{}'").format(
+                self.vertex_group, self.kind.lower(), obj.name
+            ),
         )
         return {"FINISHED"}
 
@@ -323,7 +334,8 @@ class KODAWARI_OT_swim_fin_find(bpy.types.Operator):
         found = self._search.found()
         if not found:
             self.report(
-                {"WARNING"}, f"No fins found on '{obj.name}': nothing stands out of the body"
+                {"WARNING"},
+                tip_("No fins found on '{}': nothing stands out of the body").format(obj.name),
             )
             return {"CANCELLED"}
         added = []
@@ -356,7 +368,10 @@ class KODAWARI_OT_swim_fin_find(bpy.types.Operator):
                         add_fin(obj, name, kind, rebind=False)
                 added.append(f"{name} ({len(indices)} vertices)")
         runtime.rebind(obj, known)
-        self.report({"INFO"}, f"Found {len(found)} fin(s) on '{obj.name}': " + ", ".join(added))
+        self.report(
+            {"INFO"},
+            tip_("Found {} fin(s) on '{}': {}").format(len(found), obj.name, ", ".join(added)),
+        )
         return {"FINISHED"}
 
     def execute(self, context):
@@ -382,7 +397,7 @@ class KODAWARI_OT_swim_fin_find(bpy.types.Operator):
     def modal(self, context, event):
         if event.type == "ESC":
             self._end(context)
-            self.report({"WARNING"}, "Find Fins cancelled: nothing was changed")
+            self.report({"WARNING"}, tip_("Find Fins cancelled: nothing was changed"))
             return {"CANCELLED"}
         if event.type != "TIMER":
             return {"RUNNING_MODAL"}
@@ -390,7 +405,7 @@ class KODAWARI_OT_swim_fin_find(bpy.types.Operator):
             self._search.step()
         except ValueError as exc:
             self._end(context)
-            self.report({"ERROR"}, f"Find Fins failed, nothing was changed: {exc}")
+            self.report({"ERROR"}, tip_("Find Fins failed, nothing was changed: {}").format(exc))
             return {"CANCELLED"}
         context.window_manager.progress_update(self._search.steps_done)
         if context.area:
@@ -426,7 +441,7 @@ class KODAWARI_OT_swim_flip_head(bpy.types.Operator):
             return {"CANCELLED"}
         settings = obj.kodawari_swim
         settings.head_axis = midline.OPPOSITE[settings.head_axis]
-        self.report({"INFO"}, f"Head now along {midline.LABEL[settings.head_axis]}")
+        self.report({"INFO"}, tip_("Head now along {}").format(midline.LABEL[settings.head_axis]))
         return {"FINISHED"}
 
 
@@ -476,9 +491,9 @@ class KODAWARI_OT_swim_free_bake(bpy.types.Operator):
     def execute(self, context):
         obj = _active_mesh(context)
         if obj is None or obj.type != "MESH" or obj.kodawari_swim.baked == "NONE":
-            self.report({"ERROR"}, "Select a fish with a baked swim first")
+            self.report({"ERROR"}, tip_("Select a fish with a baked swim first"))
             return {"CANCELLED"}
-        error = editable.why_not(obj, "free its bake")
+        error = editable.why_not(obj, tip_("free its bake"))
         if error:
             self.report({"ERROR"}, error)
             return {"CANCELLED"}
@@ -488,6 +503,9 @@ class KODAWARI_OT_swim_free_bake(bpy.types.Operator):
         if runtime.is_live(obj):
             runtime.evaluate(obj, context.scene)
         self.report(
-            {"INFO"}, f"Freed the bake of '{obj.name}': it swims live again with the same setup"
+            {"INFO"},
+            tip_("Freed the bake of '{}': it swims live again with the same setup").format(
+                obj.name
+            ),
         )
         return {"FINISHED"}

@@ -4,6 +4,7 @@ Cancel puts back exactly what was there."""
 
 import bpy
 import numpy as np
+from bpy.app.translations import pgettext_tip as tip_
 
 from .. import fcurves, native
 from ..bake_job import BakeJob
@@ -39,7 +40,7 @@ def _path_points(context, obj, path_obj):
     finally:
         evaluated.to_mesh_clear()
     if n < 2:
-        raise ValueError(f"the path curve '{path_obj.name}' has no length")
+        raise ValueError(tip_("the path curve '{}' has no length").format(path_obj.name))
     # World points less the armature's placement: the gait frame (rig.gait_frame).
     m = path_obj.matrix_world
     rotation = rigmod.mat3(m)
@@ -95,8 +96,9 @@ def _heightfield(context, obj, ground, rig, lo, hi, max_cells=256):
                 heights[j * nx + i] = (ground.matrix_world @ hit[0]).z - origin.z
     if misses:
         raise ValueError(
-            f"the ground '{ground.name}' does not lie under the whole run "
-            f"({misses} of {nx * ny} rays missed): move or enlarge it, or clear Ground"
+            tip_(
+                "the ground '{}' does not lie under the whole run ({} of {} rays missed): move or enlarge it, or clear Ground"
+            ).format(ground.name, misses, nx * ny)
         )
     return {
         "x0": float(lo[0]),
@@ -146,9 +148,9 @@ class GaitBakeJob(BakeJob):
 
     def __init__(self, context, obj, frame_start, frame_end):
         if obj is None or obj.type != "ARMATURE":
-            raise ValueError("the active object is not an armature")
+            raise ValueError(tip_("the active object is not an armature"))
         if frame_end <= frame_start:
-            raise ValueError("frame_end must be after frame_start")
+            raise ValueError(tip_("frame_end must be after frame_start"))
         kn = native.module()
         settings = obj.kodawari_gait
         self.obj = obj
@@ -158,8 +160,9 @@ class GaitBakeJob(BakeJob):
         self.rig, self.chains = rigmod.rig_dict(obj, settings)
         if self.rig["on_object"] and obj.rotation_mode not in ("XYZ", "QUATERNION"):
             raise ValueError(
-                f"root motion on the object keys its delta rotation: set '{obj.name}' to the XYZ Euler "
-                f"or Quaternion rotation mode (it is {obj.rotation_mode})"
+                tip_(
+                    "root motion on the object keys its delta rotation: set '{}' to the XYZ Euler or Quaternion rotation mode (it is {})"
+                ).format(obj.name, obj.rotation_mode)
             )
         self.table = rigmod.table_dict(settings)
         why = kn.gait_validate_table(self.table)
@@ -172,8 +175,9 @@ class GaitBakeJob(BakeJob):
         if (speed < 0).any():
             f = int(self.frames[np.argmax(speed < 0)])
             raise ValueError(
-                f"speed is negative ({speed[speed < 0][0]:.2f} m/s at frame {f}): "
-                "key speeds of 0 or more"
+                tip_("speed is negative ({:.2f} m/s at frame {}): key speeds of 0 or more").format(
+                    speed[speed < 0][0], f
+                )
             )
         length = rigmod.leg_length(self.rig)
         frame, top = kn.gait_check_speeds(
@@ -186,8 +190,9 @@ class GaitBakeJob(BakeJob):
             g = int(mode[frame])
             what = "the gait table" if g < 0 else GAIT_NAMES[g]
             raise ValueError(
-                f"speed {speed[frame]:.2f} m/s at frame {int(self.frames[frame])} is past the range of "
-                f"{what} (top {top:.2f} m/s): lower it or raise the table's top speed"
+                tip_(
+                    "speed {:.2f} m/s at frame {} is past the range of {} (top {:.2f} m/s): lower it or raise the table's top speed"
+                ).format(speed[frame], int(self.frames[frame]), what, top)
             )
         path = _path_points(context, obj, settings.path) if settings.path is not None else None
         ground = None
@@ -211,8 +216,9 @@ class GaitBakeJob(BakeJob):
             if miss.max() > 0.02:
                 f = int(self.frames[np.argmax(miss.max(axis=1))])
                 raise ValueError(
-                    f"the ground '{settings.ground.name}' is out of the legs' reach (a planted foot "
-                    f"misses it by {miss.max():.2f} m at frame {f})"
+                    tip_(
+                        "the ground '{}' is out of the legs' reach (a planted foot misses it by {:.2f} m at frame {})"
+                    ).format(settings.ground.name, miss.max(), f)
                 )
         self.result = result
         self.axes = rigmod.hinge_axes(obj, self.chains, self.rig["forward"])
@@ -389,7 +395,7 @@ class GaitBakeJob(BakeJob):
             self.action.name = name
         runtime.remember(self.obj, self)
         self.obj.update_tag()
-        return f"Baked {len(self.frames)} frames of gait on '{self.obj.name}'"
+        return tip_("Baked {} frames of gait on '{}'").format(len(self.frames), self.obj.name)
 
     def cancel(self):
         """Put back the action, slot, rotation modes and custom properties."""

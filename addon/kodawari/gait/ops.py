@@ -3,6 +3,7 @@ gait_report (measure the baked Action, write PNG + JSON)."""
 
 import bpy
 import numpy as np
+from bpy.app.translations import pgettext_tip as tip_
 
 from .. import editable, native
 from ..bake_job import BakeError, BakeOperator, frame_range
@@ -63,9 +64,9 @@ class KODAWARI_OT_gait_setup(bpy.types.Operator):
     def execute(self, context):
         obj = _armature(context)
         if obj is None:
-            self.report({"ERROR"}, "Gait Setup needs an armature as the active object")
+            self.report({"ERROR"}, tip_("Gait Setup needs an armature as the active object"))
             return {"CANCELLED"}
-        why = editable.why_not(obj, "get a gait")
+        why = editable.why_not(obj, tip_("get a gait"))
         if why:
             self.report({"ERROR"}, why)
             return {"CANCELLED"}
@@ -90,36 +91,32 @@ class KODAWARI_OT_gait_setup(bpy.types.Operator):
             rigmod.gait_frame(obj)
             legs, how = (
                 rigmod.find_legs_from_feet(armature, selected),
-                "from the four selected feet",
+                tip_("from the four selected feet"),
             )
         else:
-            legs, how = rigmod.find_legs_by_name(armature), "by name"
+            legs, how = rigmod.find_legs_by_name(armature), tip_("by name")
         missing = [k for k in LEG_NAMES if k not in legs]
         if missing:
             found = ", ".join(f"{k} ({len(v)} bones)" for k, v in legs.items()) or "none"
-            return (
-                f"Found fewer than four legs {how}: found {found}; missing {', '.join(missing)}. "
-                "Name leg bones with a side (.L/.R, _l/_r, Left/Right, 'L ') and a limb (thigh, shin, foot, "
-                "upper_arm, forearm, hand, or fore/hind), or select the four foot bones in Pose Mode"
-            )
+            return tip_(
+                "Found fewer than four legs {}: found {}; missing {}. Name leg bones with a side (.L/.R, _l/_r, Left/Right, 'L ') and a limb (thigh, shin, foot, upper_arm, forearm, hand, or fore/hind), or select the four foot bones in Pose Mode"
+            ).format(how, found, ", ".join(missing))
         for k in LEG_NAMES:
             if len(legs[k]) < 2:
-                return (
-                    f"Leg {k} ('{legs[k][0]}') has a single bone; a leg needs 2 to 6 bones "
-                    "(a bone from the body to the foot cannot bend)"
-                )
+                return tip_(
+                    "Leg {} ('{}') has a single bone; a leg needs 2 to 6 bones (a bone from the body to the foot cannot bend)"
+                ).format(k, legs[k][0])
             if len(legs[k]) > 6:
-                return (
-                    f"Leg {k} has {len(legs[k])} bones ({' > '.join(legs[k])}); a leg needs 2 to 6"
+                return tip_("Leg {} has {} bones ({}); a leg needs 2 to 6").format(
+                    k, len(legs[k]), " > ".join(legs[k])
                 )
         body = rigmod.find_body(armature, legs)
         root_motion = self.root_motion
         if root_motion == "AUTO":
             root_motion = "BONE" if body is not None else "OBJECT"
         if root_motion == "BONE" and body is None:
-            return (
-                "No body bone: the four legs have no common parent bone to carry root motion "
-                "(use Root Motion: Armature Object)"
+            return tip_(
+                "No body bone: the four legs have no common parent bone to carry root motion (use Root Motion: Armature Object)"
             )
         # Validate the geometry before touching the settings.
         forward = rigmod.forward_of(obj, legs)
@@ -146,13 +143,19 @@ class KODAWARI_OT_gait_setup(bpy.types.Operator):
                 )
         why = native.module().gait_validate_rig(probe)
         if why:
-            return f"The legs cannot be solved: {why}"
+            return tip_("The legs cannot be solved: {}").format(why)
         rigmod.fill_defaults(
             obj.kodawari_gait, obj, legs, body, preset=self.limits, root_motion=root_motion
         )
         summary = "; ".join(f"{k}: {' > '.join(legs[k])}" for k in LEG_NAMES)
-        where = f"body bone '{body}'" if root_motion == "BONE" else "the armature object"
-        self.report({"INFO"}, f"Found 4 legs {how}; root motion on {where}. {summary}")
+        where = (
+            tip_("body bone '{}'").format(body)
+            if root_motion == "BONE"
+            else tip_("the armature object")
+        )
+        self.report(
+            {"INFO"}, tip_("Found 4 legs {}; root motion on {}. {}").format(how, where, summary)
+        )
         return None
 
 
@@ -165,14 +168,14 @@ class KODAWARI_OT_gait_bake(BakeOperator, bpy.types.Operator):
 
     def make_job(self, context):
         obj = _armature(context) or context.active_object
-        why = editable.why_not(obj, "bake a gait")
+        why = editable.why_not(obj, tip_("bake a gait"))
         if why:
             raise BakeError(why)
         start, end = frame_range(self, context.scene)
         try:
             return GaitBakeJob(context, obj, start, end)
         except ValueError as exc:
-            raise BakeError(f"Gait bake: {exc}") from None
+            raise BakeError(tip_("Gait bake: {}").format(exc)) from None
 
 
 class KODAWARI_OT_gait_report(bpy.types.Operator):
@@ -192,18 +195,18 @@ class KODAWARI_OT_gait_report(bpy.types.Operator):
     def execute(self, context):
         obj = _armature(context)
         if obj is None:
-            self.report({"ERROR"}, "Gait Report needs an armature as the active object")
+            self.report({"ERROR"}, tip_("Gait Report needs an armature as the active object"))
             return {"CANCELLED"}
         if not self.filepath:
-            self.report({"ERROR"}, "Gait Report needs a file path")
+            self.report({"ERROR"}, tip_("Gait Report needs a file path"))
             return {"CANCELLED"}
         scene = context.scene
         try:
             png, js, _ = write_report(obj, self.filepath, scene.render.fps / scene.render.fps_base)
         except (ValueError, OSError) as exc:
-            self.report({"ERROR"}, f"Gait report: {exc}")
+            self.report({"ERROR"}, tip_("Gait report: {}").format(exc))
             return {"CANCELLED"}
-        self.report({"INFO"}, f"Wrote {png} and {js}")
+        self.report({"INFO"}, tip_("Wrote {} and {}").format(png, js))
         return {"FINISHED"}
 
     def invoke(self, context, event):

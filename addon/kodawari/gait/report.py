@@ -7,6 +7,7 @@ import os
 
 import bpy
 import numpy as np
+from bpy.app.translations import pgettext_tip as tip_
 
 from .. import fcurves
 from . import metrics, report_svg
@@ -37,14 +38,16 @@ def read_baked(obj):
     anim = obj.animation_data
     action = anim.action if anim is not None else None
     if action is None:
-        raise ValueError(f"'{obj.name}' has no Action: bake the gait first")
+        raise ValueError(tip_("'{}' has no Action: bake the gait first").format(obj.name))
     settings = obj.kodawari_gait
     rig, chains = rigmod.rig_dict(obj, settings)
     contacts = [_curve(action, obj, f'["{p}"]') for p in CONTACT_PROPS]
     gait = _curve(action, obj, f'["{GAIT_PROP}"]')
     if any(c is None for c in contacts) or gait is None:
         raise ValueError(
-            f"'{obj.name}' has no gait bake (no kodawari_contact_* channels): bake the gait first"
+            tip_(
+                "'{}' has no gait bake (no kodawari_contact_* channels): bake the gait first"
+            ).format(obj.name)
         )
     frames = gait[0]
     n = len(frames)
@@ -56,14 +59,18 @@ def read_baked(obj):
             if mode == "X":
                 keys = _curve(action, obj, f'pose.bones["{name}"].rotation_euler', 0)
                 if keys is None or len(keys[0]) != n:
-                    raise ValueError(f"bone '{name}' has no baked rotation: bake the gait again")
+                    raise ValueError(
+                        tip_("bone '{}' has no baked rotation: bake the gait again").format(name)
+                    )
                 angles.append(sign * keys[1].astype(np.float64))
                 continue
             q = []
             for i in range(4):
                 keys = _curve(action, obj, f'pose.bones["{name}"].rotation_quaternion', i)
                 if keys is None or len(keys[0]) != n:
-                    raise ValueError(f"bone '{name}' has no baked rotation: bake the gait again")
+                    raise ValueError(
+                        tip_("bone '{}' has no baked rotation: bake the gait again").format(name)
+                    )
                 q.append(keys[1].astype(np.float64))
             q = np.stack(q, axis=1)
             # Hinge angle back from the quaternion (w, axis * sin(a/2)).
@@ -83,7 +90,9 @@ def read_baked(obj):
             _curve(action, obj, f'pose.bones["{body}"].rotation_quaternion', i) for i in range(4)
         ]
         if any(c is None for c in loc + rot):
-            raise ValueError(f"the body bone '{body}' has no baked motion: bake the gait again")
+            raise ValueError(
+                tip_("the body bone '{}' has no baked motion: bake the gait again").format(body)
+            )
         data["body_location"] = np.ascontiguousarray(
             np.stack([c[1] for c in loc], axis=1), dtype=np.float64
         )

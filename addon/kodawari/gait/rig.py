@@ -4,6 +4,7 @@ native planner, and the horse defaults. Set-up time only; no per-frame work here
 import math
 
 import numpy as np
+from bpy.app.translations import pgettext_tip as tip_
 
 from .. import native
 from . import legs as legfinder
@@ -63,11 +64,14 @@ def gait_frame(obj):
     scales = np.linalg.norm(m, axis=0)
     if not np.all(scales > 1e-9) or scales.max() - scales.min() > 1e-4 * scales.max():
         raise ValueError(
-            f"'{obj.name}' has a non-uniform scale ({', '.join(f'{v:.3g}' for v in scales)}): "
-            "apply the scale (Ctrl+A > Scale) first"
+            tip_(
+                "'{}' has a non-uniform scale ({}): apply the scale (Ctrl+A > Scale) first"
+            ).format(obj.name, ", ".join(f"{v:.3g}" for v in scales))
         )
     if np.linalg.det(m) < 0:
-        raise ValueError(f"'{obj.name}' has a negative (mirroring) scale: apply the scale first")
+        raise ValueError(
+            tip_("'{}' has a negative (mirroring) scale: apply the scale first").format(obj.name)
+        )
     return m, float(scales.mean())
 
 
@@ -250,7 +254,7 @@ def table_dict(settings):
     for name in GAIT_NAMES:
         entry = by_name.get(name)
         if entry is None:
-            raise ValueError(f"the gait table has no {name} row: run Gait Setup")
+            raise ValueError(tip_("the gait table has no {} row: run Gait Setup").format(name))
         rows.append([float(getattr(entry, c)) for c in kn.GAIT_COLUMNS])
     return {
         "gaits": np.array(rows, dtype=np.float64),
@@ -269,33 +273,44 @@ def rig_dict(obj, settings):
     for leg in settings.legs:
         names = [b.name for b in leg.bones]
         if len(names) < 2:
-            raise ValueError(f"leg {leg.name} has {len(names)} bone(s); a leg needs 2 to 6")
+            raise ValueError(
+                tip_("leg {} has {} bone(s); a leg needs 2 to 6").format(leg.name, len(names))
+            )
         if len(names) > 6:
-            raise ValueError(f"leg {leg.name} has {len(names)} bones; a leg needs 2 to 6")
+            raise ValueError(
+                tip_("leg {} has {} bones; a leg needs 2 to 6").format(leg.name, len(names))
+            )
         for n in names:
             if n not in armature.bones:
-                raise ValueError(f"leg {leg.name}: bone '{n}' is not in the armature")
+                raise ValueError(
+                    tip_("leg {}: bone '{}' is not in the armature").format(leg.name, n)
+                )
         legs[leg.name] = leg
     missing = [k for k in LEG_NAMES if k not in legs]
     if missing:
         raise ValueError(
-            f"fewer than four legs set up (missing {', '.join(missing)}): run Gait Setup"
+            tip_("fewer than four legs set up (missing {}): run Gait Setup").format(
+                ", ".join(missing)
+            )
         )
     on_object = settings.root_motion == "OBJECT"
     if not on_object and settings.body_bone not in armature.bones:
         raise ValueError(
-            "no body bone set (the bone carrying root motion): run Gait Setup, "
-            "or set Root Motion to Armature Object"
+            tip_(
+                "no body bone set (the bone carrying root motion): run Gait Setup, or set Root Motion to Armature Object"
+            )
         )
     if not on_object and armature.bones[settings.body_bone].use_connect:
         raise ValueError(
-            f"the body bone '{settings.body_bone}' is connected to its parent, so Blender ignores "
-            "its location keys: choose an unconnected bone or Root Motion: Armature Object"
+            tip_(
+                "the body bone '{}' is connected to its parent, so Blender ignores its location keys: choose an unconnected bone or Root Motion: Armature Object"
+            ).format(settings.body_bone)
         )
     if on_object and obj.parent is not None:
         raise ValueError(
-            f"'{obj.name}' has a parent: root motion on the object needs an unparented armature "
-            "(or use Root Motion: Body Bone)"
+            tip_(
+                "'{}' has a parent: root motion on the object needs an unparented armature (or use Root Motion: Body Bone)"
+            ).format(obj.name)
         )
     m, scale = gait_frame(obj)
     chains = {k: [b.name for b in legs[k].bones] for k in LEG_NAMES}

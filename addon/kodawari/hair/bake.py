@@ -5,6 +5,7 @@ simulation is switched off for the bake and everything it touched is put back.""
 
 import bpy
 import numpy as np
+from bpy.app.translations import pgettext_tip as tip_
 
 from .. import editable, fcurves
 from ..bake_job import BakeError, BakeJob
@@ -31,12 +32,12 @@ class HairBakeJob(BakeJob):
 
     def prepare(self):
         obj, scene = self.obj, self.scene
-        why = editable.why_not(obj, "bake its hair")
+        why = editable.why_not(obj, tip_("bake its hair"))
         if why:
             raise BakeError(why)
         settings = obj.kodawari_hair
         if not len(settings.rods):
-            raise BakeError("This armature has no rods to bake")
+            raise BakeError(tip_("This armature has no rods to bake"))
         self.rt = runtime.ArmatureRuntime(obj)  # validates every rod before anything changes
         if self.rt.error:
             raise BakeError(self.rt.error)
@@ -121,11 +122,14 @@ class HairBakeJob(BakeJob):
         obj.kodawari_hair.enabled = False
         self.scene.frame_set(snap["frame"][0], subframe=snap["frame"][1])
         self.snapshot = None
-        return (
-            f"Baked {len(self.chains)} bones over frames {self.start}-{self.end} into action "
-            f"'{action.name}'"
-            + (" (NLA track)" if self.new_action else "")
-            + "; live simulation turned off"
+        return tip_(
+            "Baked {} bones over frames {}-{} into action '{}'{}; live simulation turned off"
+        ).format(
+            len(self.chains),
+            self.start,
+            self.end,
+            action.name,
+            tip_(" (NLA track)") if self.new_action else "",
         )
 
     def _write(self, action, frames, values):

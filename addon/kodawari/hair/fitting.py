@@ -3,6 +3,7 @@ of one stroke as seen from the current view. The stroke is projected onto the pl
 through the chain root facing the view, resampled by the bone lengths from the root,
 and each bone is turned (no twist) to point at its resampled joint."""
 
+from bpy.app.translations import pgettext_tip as tip_
 from mathutils import Vector
 
 
@@ -62,10 +63,10 @@ def fit_chain_to_stroke(obj, parent, chain, points_world, eye, forward, perspect
     """Pose-bone rotations (quaternions) that lay `chain` along the stroke."""
     root_world = obj.matrix_world @ chain[0].head
     if perspective and (root_world - eye).dot(forward) <= 1e-6:
-        raise FitError("The chain root is not in front of the view")
+        raise FitError(tip_("The chain root is not in front of the view"))
     projected = project_to_root_plane(points_world, root_world, eye, forward, perspective)
     if len(projected) < 2:
-        raise FitError("The stroke is behind the view")
+        raise FitError(tip_("The stroke is behind the view"))
     to_armature = obj.matrix_world.inverted()
     polyline = [to_armature @ p for p in projected]
     # Clean duplicates, and start the stroke at the end nearer the root.
@@ -74,7 +75,7 @@ def fit_chain_to_stroke(obj, parent, chain, points_world, eye, forward, perspect
         if (p - cleaned[-1]).length > 1e-7:
             cleaned.append(p)
     if len(cleaned) < 2:
-        raise FitError("The stroke has no length")
+        raise FitError(tip_("The stroke has no length"))
     root = chain[0].head.copy()
     if (cleaned[-1] - root).length < (cleaned[0] - root).length:
         cleaned.reverse()

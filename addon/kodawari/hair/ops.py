@@ -4,6 +4,7 @@ nothing when it refuses (a clear report, {'CANCELLED'})."""
 import math
 
 import bpy
+from bpy.app.translations import pgettext_tip as tip_
 from mathutils import Vector
 
 from .. import editable
@@ -19,8 +20,8 @@ class _Refusal(Exception):
 def _armature(context):
     obj = context.active_object
     if obj is None or obj.type != "ARMATURE":
-        raise _Refusal("Select an armature: the active object is not an armature")
-    why = editable.why_not(obj, "change its hair")
+        raise _Refusal(tip_("Select an armature: the active object is not an armature"))
+    why = editable.why_not(obj, tip_("change its hair"))
     if why:
         raise _Refusal(why)
     return obj
@@ -29,11 +30,13 @@ def _armature(context):
 def _rod(obj, index):
     settings = obj.kodawari_hair
     if not len(settings.rods):
-        raise _Refusal("This armature has no rods: add one with Add Rod (kodawari.rod_add)")
+        raise _Refusal(tip_("This armature has no rods: add one with Add Rod (kodawari.rod_add)"))
     i = settings.active_rod if index < 0 else index
     if i >= len(settings.rods):
         raise _Refusal(
-            f"Rod index {i} is out of range (the armature has {len(settings.rods)} rods)"
+            tip_("Rod index {} is out of range (the armature has {} rods)").format(
+                i, len(settings.rods)
+            )
         )
     return i, settings.rods[i]
 
@@ -58,7 +61,9 @@ def _pose_shape(chain):
         )
         if not chains.finite_quaternions(q):
             raise _Refusal(
-                f"Bone '{pb.name}' has an invalid rotation (NaN or zero): fix the pose before keying"
+                tip_(
+                    "Bone '{}' has an invalid rotation (NaN or zero): fix the pose before keying"
+                ).format(pb.name)
             )
         n = math.sqrt(sum(c * c for c in q))
         shape.append(tuple(c / n for c in q))
@@ -86,11 +91,11 @@ def _eye(context, source):
     if source == "VIEWPORT":
         eye = _viewport_eye(context)
         if eye is None:
-            raise _Refusal("No 3D viewport to look through here: use source 'CAMERA'")
+            raise _Refusal(tip_("No 3D viewport to look through here: use source 'CAMERA'"))
         return eye
     camera = context.scene.camera
     if camera is None:
-        raise _Refusal("The scene has no active camera: set one (or use source 'VIEWPORT')")
+        raise _Refusal(tip_("The scene has no active camera: set one (or use source 'VIEWPORT')"))
     m = camera.matrix_world
     forward = -(m.to_3x3().normalized() @ Vector((0.0, 0.0, 1.0)))
     perspective = camera.type != "CAMERA" or camera.data.type != "ORTHO"
@@ -131,7 +136,9 @@ class KODAWARI_OT_rod_add(_HairOperator, bpy.types.Operator):
         obj = _armature(context)
         selected = [pb for pb in obj.pose.bones if chains.is_selected(pb)]
         if not selected:
-            raise _Refusal("No bones selected: select the first bone of each chain in pose mode")
+            raise _Refusal(
+                tip_("No bones selected: select the first bone of each chain in pose mode")
+            )
         names = {pb.name for pb in selected}
         roots = [pb.bone for pb in selected if pb.parent is None or pb.parent.name not in names]
         used = set()
@@ -144,7 +151,9 @@ class KODAWARI_OT_rod_add(_HairOperator, bpy.types.Operator):
         for root in roots:
             if root.parent is None:
                 raise _Refusal(
-                    f"Bone '{root.name}' has no parent to attach to: a rod hangs from a kinematic bone"
+                    tip_(
+                        "Bone '{}' has no parent to attach to: a rod hangs from a kinematic bone"
+                    ).format(root.name)
                 )
             try:
                 chain = chains.chain_from(root)
@@ -152,7 +161,7 @@ class KODAWARI_OT_rod_add(_HairOperator, bpy.types.Operator):
                 raise _Refusal(str(exc)) from None
             taken = [b.name for b in chain if b.name in used]
             if taken:
-                raise _Refusal(f"Bone '{taken[0]}' already belongs to a rod")
+                raise _Refusal(tip_("Bone '{}' already belongs to a rod").format(taken[0]))
             used.update(b.name for b in chain)
             plans.append((root, chain))
         settings = obj.kodawari_hair
@@ -171,7 +180,7 @@ class KODAWARI_OT_rod_add(_HairOperator, bpy.types.Operator):
         context.scene.render.use_lock_interface = True
         names = [r.name for r, _ in plans]
         shown = ", ".join(names[:8]) + (f" and {len(names) - 8} more" if len(names) > 8 else "")
-        self.report({"INFO"}, f"Added {len(plans)} rod(s): {shown}")
+        self.report({"INFO"}, tip_("Added {} rod(s): {}").format(len(plans), shown))
         return {"FINISHED"}
 
 
@@ -193,7 +202,7 @@ class KODAWARI_OT_rod_remove(_HairOperator, bpy.types.Operator):
         settings.rods.remove(index)
         settings.active_rod = max(0, min(settings.active_rod, len(settings.rods) - 1))
         runtime.invalidate(obj)
-        self.report({"INFO"}, f"Removed rod '{name}'")
+        self.report({"INFO"}, tip_("Removed rod '{}'").format(name))
         return {"FINISHED"}
 
 
@@ -234,7 +243,7 @@ class KODAWARI_OT_rod_key_view(_HairOperator, bpy.types.Operator):
         key.direction = direction
         key.influence = self.influence
         runtime.invalidate(obj)
-        self.report({"INFO"}, f"Keyed '{key.name}' on rod '{rod.root_bone}'")
+        self.report({"INFO"}, tip_("Keyed '{}' on rod '{}'").format(key.name, rod.root_bone))
         return {"FINISHED"}
 
 
@@ -245,7 +254,9 @@ def view_direction(obj, reference, eye_world):
     d = rotation.inverted() @ (eye - reference.matrix.translation)
     if d.length < 1e-6:
         raise _Refusal(
-            f"The camera is at the reference bone '{reference.name}': the view direction is undefined"
+            tip_(
+                "The camera is at the reference bone '{}': the view direction is undefined"
+            ).format(reference.name)
         )
     return d.normalized()
 
@@ -274,12 +285,14 @@ class KODAWARI_OT_rod_key_pose(_HairOperator, bpy.types.Operator):
         shape = _pose_shape(chain)
         rotation = tuple(reference.matrix.to_quaternion().normalized())
         if not chains.finite_quaternions(rotation):
-            raise _Refusal(f"Reference bone '{reference.name}' has an invalid rotation")
+            raise _Refusal(
+                tip_("Reference bone '{}' has an invalid rotation").format(reference.name)
+            )
         key = _new_key(rod, "POSE", shape, "Pose")
         key.rotation = rotation
         key.influence = self.influence
         runtime.invalidate(obj)
-        self.report({"INFO"}, f"Keyed '{key.name}' on rod '{rod.root_bone}'")
+        self.report({"INFO"}, tip_("Keyed '{}' on rod '{}'").format(key.name, rod.root_bone))
         return {"FINISHED"}
 
 
@@ -312,20 +325,23 @@ class KODAWARI_OT_rod_key_speed(_HairOperator, bpy.types.Operator):
         _, rod = _rod(obj, self.rod_index)
         _, _, chain = _chain_pose_bones(obj, rod)
         if not math.isfinite(self.speed):
-            raise _Refusal("The speed must be a finite number")
+            raise _Refusal(tip_("The speed must be a finite number"))
         shape = _pose_shape(chain)
         key = _new_key(rod, "SPEED", shape, "Speed")
         key.speed = self.speed
         key.influence = self.influence
         runtime.invalidate(obj)
-        self.report({"INFO"}, f"Keyed '{key.name}' at {self.speed:g} m/s on rod '{rod.root_bone}'")
+        self.report(
+            {"INFO"},
+            tip_("Keyed '{}' at {:g} m/s on rod '{}'").format(key.name, self.speed, rod.root_bone),
+        )
         return {"FINISHED"}
 
 
 def _key(rod, index):
     i = rod.active_key if index < 0 else index
     if not len(rod.keys) or i >= len(rod.keys):
-        raise _Refusal(f"Rod '{rod.root_bone}' has no key {i}")
+        raise _Refusal(tip_("Rod '{}' has no key {}").format(rod.root_bone, i))
     return i, rod.keys[i]
 
 
@@ -349,12 +365,14 @@ class KODAWARI_OT_rod_key_preview(_HairOperator, bpy.types.Operator):
         _, _, chain = _chain_pose_bones(obj, rod)
         if len(key.shape) != len(chain):
             raise _Refusal(
-                f"Key '{key.name}' has {len(key.shape)} joints, the chain has {len(chain)}: re-key it"
+                tip_("Key '{}' has {} joints, the chain has {}: re-key it").format(
+                    key.name, len(key.shape), len(chain)
+                )
             )
         for pb, joint in zip(chain, key.shape):
             pb.rotation_mode = "QUATERNION"
             pb.rotation_quaternion = joint.rotation
-        self.report({"INFO"}, f"Chain '{rod.root_bone}' shows key '{key.name}'")
+        self.report({"INFO"}, tip_("Chain '{}' shows key '{}'").format(rod.root_bone, key.name))
         return {"FINISHED"}
 
 
@@ -381,7 +399,7 @@ class KODAWARI_OT_rod_rekey(_HairOperator, bpy.types.Operator):
         for q in shape:
             key.shape.add().rotation = q
         runtime.invalidate(obj)
-        self.report({"INFO"}, f"Re-keyed '{key.name}'")
+        self.report({"INFO"}, tip_("Re-keyed '{}'").format(key.name))
         return {"FINISHED"}
 
 
@@ -406,7 +424,7 @@ class KODAWARI_OT_rod_key_remove(_HairOperator, bpy.types.Operator):
         rod.keys.remove(i)
         rod.active_key = max(0, min(rod.active_key, len(rod.keys) - 1))
         runtime.invalidate(obj)
-        self.report({"INFO"}, f"Deleted key '{name}'")
+        self.report({"INFO"}, tip_("Deleted key '{}'").format(name))
         return {"FINISHED"}
 
 
@@ -454,7 +472,9 @@ class KODAWARI_OT_rod_collider_add(_HairOperator, bpy.types.Operator):
         name = self.bone or (obj.data.bones.active.name if obj.data.bones.active else "")
         if not name or name not in obj.data.bones:
             raise _Refusal(
-                f"Bone '{name}' is not in the armature: pick the bone the collider follows"
+                tip_("Bone '{}' is not in the armature: pick the bone the collider follows").format(
+                    name
+                )
             )
         collider = obj.kodawari_hair.colliders.add()
         collider.bone, collider.shape, collider.radius = name, self.shape, self.radius
@@ -475,7 +495,7 @@ class KODAWARI_OT_rod_collider_remove(_HairOperator, bpy.types.Operator):
         obj = _armature(context)
         settings = obj.kodawari_hair
         if not len(settings.colliders):
-            raise _Refusal("This armature has no colliders")
+            raise _Refusal(tip_("This armature has no colliders"))
         settings.colliders.remove(min(settings.active_collider, len(settings.colliders) - 1))
         settings.active_collider = max(0, settings.active_collider - 1)
         runtime.invalidate(obj)
@@ -515,7 +535,9 @@ class KODAWARI_OT_rod_fit_stroke(_HairOperator, bpy.types.Operator):
         points, origin = strokes.find_stroke(context, exclude=obj)
         if not points or len(points) < 2:
             raise _Refusal(
-                "No stroke to fit: draw an annotation (or grease-pencil) stroke of two or more points"
+                tip_(
+                    "No stroke to fit: draw an annotation (or grease-pencil) stroke of two or more points"
+                )
             )
         eye, forward, perspective = _eye(context, self.source)
         try:
@@ -527,7 +549,9 @@ class KODAWARI_OT_rod_fit_stroke(_HairOperator, bpy.types.Operator):
         for pb, q in zip(chain, rotations):
             pb.rotation_mode = "QUATERNION"
             pb.rotation_quaternion = q
-        self.report({"INFO"}, f"Chain '{rod.root_bone}' fitted to the {origin} stroke")
+        self.report(
+            {"INFO"}, tip_("Chain '{}' fitted to the {} stroke").format(rod.root_bone, origin)
+        )
         return {"FINISHED"}
 
 

@@ -2,8 +2,9 @@
 labels, iface_("...") calls) and the reports wrapped in tip_("..."), read from their
 source with ast so the translation check sees strings added later without running them.
 
-Reports are translated only where the operator wraps its message in tip_() with
-str.format placeholders (an f-string has no fixed text to look up): fish/apply.py."""
+Reports are translated where the message is wrapped in tip_() with str.format
+placeholders (an f-string has no fixed text to look up); every add-on source file is
+searched for tip_("...") calls (reports(), below), so a new report needs its entry too."""
 
 import ast
 import os
@@ -54,11 +55,55 @@ def _literals(tree):
                         yield value.value
 
 
-def strings():
+REPORT_CALLS = {"tip_", "pgettext_tip"}
+
+
+def _parse(path):
+    with open(path, encoding="utf-8") as source:
+        return ast.parse(source.read())
+
+
+def sources():
+    """Every Python file of the add-on except the translation tables themselves."""
+    for folder, _dirs, files in os.walk(PACKAGE):
+        if os.path.basename(folder) in ("translations", "__pycache__"):
+            continue
+        for name in sorted(files):
+            if name.endswith(".py"):
+                yield os.path.join(folder, name)
+
+
+def reports():
+    """The literal first argument of every tip_("...") call in the add-on (the report and
+    error messages: operators' reports, bake errors, problems said once) and bake job titles."""
     found = set()
+    for path in sources():
+        for node in ast.walk(_parse(path)):
+            if isinstance(node, ast.Call):
+                name = getattr(node.func, "id", None) or getattr(node.func, "attr", None)
+                first = node.args[0] if node.args else None
+                if (
+                    name in REPORT_CALLS
+                    and isinstance(first, ast.Constant)
+                    and isinstance(first.value, str)
+                    and first.value
+                ):
+                    found.add(first.value)
+            # A bake job's `title = "..."` is said through tip_(job.title) in its reports.
+            if (
+                isinstance(node, ast.Assign)
+                and getattr(node.targets[0], "id", "") == "title"
+                and isinstance(node.value, ast.Constant)
+                and isinstance(node.value.value, str)
+            ):
+                found.add(node.value.value)
+    return found
+
+
+def strings():
+    found = reports()
     for name in UI_FILES:
         path = os.path.join(PACKAGE, name)
         if os.path.exists(path):
-            with open(path, encoding="utf-8") as source:
-                found |= set(_literals(ast.parse(source.read())))
+            found |= set(_literals(_parse(path)))
     return found
