@@ -31,6 +31,13 @@ def can_rig(obj):
     return obj is not None and obj.type == "ARMATURE"
 
 
+def split_layout(layout):
+    """Blender's property layout: labels in a left column, keyframe decorators on the right."""
+    layout.use_property_split = True
+    layout.use_property_decorate = True
+    return layout
+
+
 def add_panel(idname, label, tab, can_use, uses, operator, text, icon):
     """A headerless Properties panel holding one "Add …" button, shown on an object that could
     use a feature but does not yet (the single entry the feature's own panels give way to)."""

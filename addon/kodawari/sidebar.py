@@ -18,9 +18,7 @@ class KODAWARI_PT_sidebar(bpy.types.Panel):
         return context.object is not None
 
     def draw(self, context):
-        layout = self.layout
-        layout.use_property_split = True
-        layout.use_property_decorate = True
+        layout = in_use.split_layout(self.layout)
         obj = context.object
         layout.label(text=obj.name, icon="OBJECT_DATA")
         if not (in_use.can_swim(obj) or in_use.can_rig(obj)):

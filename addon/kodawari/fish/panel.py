@@ -30,12 +30,6 @@ class KODAWARI_UL_swim_fins(bpy.types.UIList):
         split.prop(item, "kind", text="", emboss=False)
 
 
-def _split(layout):
-    layout.use_property_split = True
-    layout.use_property_decorate = True
-    return layout
-
-
 def _live(context):
     obj = context.object
     return in_use.swim(obj) and obj.kodawari_swim.baked == "NONE"
@@ -87,7 +81,7 @@ class KODAWARI_PT_swim(_SwimPanel, bpy.types.Panel):
             visibility.draw_toggles(self.layout, settings)
 
     def draw(self, context):
-        layout = _split(self.layout)
+        layout = in_use.split_layout(self.layout)
         obj = context.object
         settings = obj.kodawari_swim
         if settings.baked != "NONE":
@@ -143,7 +137,7 @@ class KODAWARI_PT_swim_body(_SwimPanel, bpy.types.Panel):
     bl_options = {"DEFAULT_CLOSED"}
 
     def draw(self, context):
-        layout = _split(self.layout)
+        layout = in_use.split_layout(self.layout)
         settings = context.object.kodawari_swim
         col = layout.column()
         col.prop(settings, "amplitude_head", slider=True)
@@ -162,7 +156,7 @@ class KODAWARI_PT_swim_travel(_SwimPanel, bpy.types.Panel):
     bl_options = {"DEFAULT_CLOSED"}
 
     def draw(self, context):
-        layout = _split(self.layout)
+        layout = in_use.split_layout(self.layout)
         obj = context.object
         settings = obj.kodawari_swim
         col = layout.column()
@@ -192,11 +186,11 @@ class KODAWARI_PT_swim_fins(_SwimPanel, bpy.types.Panel):
         col.operator("kodawari.swim_fin_find", text="", icon="VIEWZOOM")
         if 0 <= settings.fin_index < len(settings.fins):
             fin = settings.fins[settings.fin_index]
-            col = _split(layout.column())
+            col = in_use.split_layout(layout.column())
             col.prop_search(fin, "vertex_group", obj, "vertex_groups")
             col.prop(fin, "kind")
             col.prop(fin, "motion")
-            col = _split(layout.column())
+            col = in_use.split_layout(layout.column())
             col.prop(fin, "amplitude")
             col.prop(fin, "frequency_ratio")
             col.prop(fin, "phase_lag")

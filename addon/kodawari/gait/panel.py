@@ -16,12 +16,6 @@ LEG_LABELS = {
 }
 
 
-def _split(layout):
-    layout.use_property_split = True
-    layout.use_property_decorate = True
-    return layout
-
-
 class _GaitPanel:
     bl_space_type = "PROPERTIES"
     bl_region_type = "WINDOW"
@@ -36,7 +30,7 @@ class KODAWARI_PT_gait(_GaitPanel, bpy.types.Panel):
     bl_label = "Kodawari Gait"
 
     def draw(self, context):
-        layout = _split(self.layout)
+        layout = in_use.split_layout(self.layout)
         settings = context.object.kodawari_gait
         col = layout.column()
         col.prop(settings, "speed")
@@ -53,7 +47,7 @@ class KODAWARI_PT_gait_rig(_GaitPanel, bpy.types.Panel):
     bl_options = {"DEFAULT_CLOSED"}
 
     def draw(self, context):
-        layout = _split(self.layout)
+        layout = in_use.split_layout(self.layout)
         obj = context.object
         settings = obj.kodawari_gait
         col = layout.column()
@@ -71,7 +65,7 @@ class KODAWARI_PT_gait_table(_GaitPanel, bpy.types.Panel):
     bl_options = {"DEFAULT_CLOSED"}
 
     def draw(self, context):
-        layout = _split(self.layout)
+        layout = in_use.split_layout(self.layout)
         settings = context.object.kodawari_gait
         col = layout.column()
         col.prop(settings, "use_froude")
@@ -105,7 +99,7 @@ def _gait_row_panel(name):
             self.layout.prop(_entry(context.object.kodawari_gait, name), "use_in_auto", text="")
 
         def draw(self, context):
-            layout = _split(self.layout)
+            layout = in_use.split_layout(self.layout)
             settings = context.object.kodawari_gait
             entry = _entry(settings, name)
             col = layout.column()
@@ -157,7 +151,7 @@ def _leg_panel(name):
             )
 
         def draw(self, context):
-            layout = _split(self.layout)
+            layout = in_use.split_layout(self.layout)
             for bone in _leg(context.object.kodawari_gait, name).bones:
                 col = layout.column(align=True)
                 col.label(text=bone.name, icon="BONE_DATA", translate=False)

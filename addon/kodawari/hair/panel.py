@@ -48,12 +48,6 @@ class KODAWARI_UL_hair_colliders(bpy.types.UIList):
         row.prop(item, "shape", text="", emboss=False)
 
 
-def _split(layout):
-    layout.use_property_split = True
-    layout.use_property_decorate = True
-    return layout
-
-
 def _active_rod(settings):
     if settings.rods and 0 <= settings.active_rod < len(settings.rods):
         return settings.rods[settings.active_rod]
@@ -103,7 +97,7 @@ class KODAWARI_PT_hair_rod(_HairPanel, bpy.types.Panel):
         return in_use.hair(context.object) and _active_rod(context.object.kodawari_hair) is not None
 
     def draw(self, context):
-        layout = _split(self.layout)
+        layout = in_use.split_layout(self.layout)
         obj = context.object
         rod = _active_rod(obj.kodawari_hair)
         col = layout.column()
@@ -125,7 +119,7 @@ class KODAWARI_PT_hair_rod_quality(_HairPanel, bpy.types.Panel):
         return KODAWARI_PT_hair_rod.poll(context)
 
     def draw(self, context):
-        layout = _split(self.layout)
+        layout = in_use.split_layout(self.layout)
         rod = _active_rod(context.object.kodawari_hair)
         col = layout.column()
         col.prop(rod, "radius")
@@ -155,7 +149,7 @@ class KODAWARI_PT_hair_keys(_HairPanel, bpy.types.Panel):
         layout.operator("kodawari.rod_fit_stroke", icon="GREASEPENCIL")
         if rod.keys and 0 <= rod.active_key < len(rod.keys):
             key = rod.keys[rod.active_key]
-            col = _split(layout.column())
+            col = in_use.split_layout(layout.column())
             col.prop(key, "condition")
             col.prop(key, "influence")
             if key.condition == "VIEW":
@@ -188,7 +182,7 @@ class KODAWARI_PT_hair_colliders(_HairPanel, bpy.types.Panel):
         col.operator("kodawari.rod_collider_remove", icon="REMOVE", text="")
         if settings.colliders and 0 <= settings.active_collider < len(settings.colliders):
             collider = settings.colliders[settings.active_collider]
-            col = _split(layout.column())
+            col = in_use.split_layout(layout.column())
             col.prop_search(collider, "bone", obj.data, "bones")
             col.prop(collider, "shape")
             col.prop(collider, "radius")
