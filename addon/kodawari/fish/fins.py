@@ -25,6 +25,7 @@ class FinPart:
         self.tangent, self.side, self.up = frame
         self.root = root  # float64 (3,) where the fin meets the body
         outward = tip - root
+        self.outward = outward / np.linalg.norm(outward)
         self.feather_on_power, self.feather_sign = _blade_facing(rest, outward, frame, kn)
         height = float(reach.max()) if len(reach) else 1.0
         self.binding = kn.FinPart(
@@ -91,16 +92,32 @@ def _outward(kind, centroid_offset, frame):
     return across / norm
 
 
-def fin_reach(rest, edges, in_fin, body_length, kn):
+def fin_reach(rest, edges, in_fin, body_length, kn, squash=None):
     """Per vertex: how far across its fin it stands from the body (path length along the
-    fin's edges from where it meets the body, smoothed; 0 on the body). Native."""
+    fin's edges from where it meets the body; 0 on the body). squash: float32 (N, 3)
+    (swing_squash): the reach then grows slowly across each swinging part's lines, so no
+    edge stretches (docs/algorithms.md §2.4). Native."""
     reach, _source = kn.swim_fin_reach(
         np.ascontiguousarray(rest, dtype=np.float32),
         edges,
         np.ascontiguousarray(in_fin, dtype=bool),
         1e-4 * body_length,
+        squash,
     )
     return reach
+
+
+SWINGING = ("FLAP", "UP_DOWN")
+
+
+def swing_squash(parts, fins, count):
+    """float32 (count, 3): on each swinging part's vertices its unit outward direction
+    (zero elsewhere), for fin_reach's squash; None when no part swings."""
+    squash = np.zeros((count, 3), dtype=np.float32)
+    for part in parts:
+        if fins[part.fin_index].motion in SWINGING:
+            squash[part.indices] = part.outward
+    return squash if squash.any() else None
 
 
 def split_sides(kind, points, axis_point, frame):
@@ -116,8 +133,12 @@ def split_sides(kind, points, axis_point, frame):
     return whole
 
 
-def build_parts(fin_index, fin, group_weights, verts, body_axis, up, kn, reach_all=None):
-    """FinParts of one fin setting; raises ValueError with a readable reason."""
+def build_parts(
+    fin_index, fin, group_weights, verts, body_axis, up, kn, reach_all=None, swing_reach_all=None
+):
+    """FinParts of one fin setting; raises ValueError with a readable reason.
+    swing_reach_all: fin_reach squashed across each swinging part's lines (swing_squash),
+    the reach its swing fades in over; the part's root and tip still come from reach_all."""
     indices = np.flatnonzero(group_weights > 0.0)
     if len(indices) < 4:
         raise ValueError(
@@ -162,6 +183,12 @@ def build_parts(fin_index, fin, group_weights, verts, body_axis, up, kn, reach_a
         # root band it would shear the fin's base (its amplitude is a share of the height).
         # The fade is a smoothstep over a share of the fin's own height (not a fixed
         # distance), applied in the core, which also bends the swing along the fin.
+        # A swing fades in over the reach squashed across the fin's lines (swing_reach_all),
+        # which grows at most 0.6 per unit length across them: across a thin fin's two faces
+        # or a fan-shaped tail, a path length growing along the swing stretched edges 1.6x.
+        if swing_reach_all is not None and np.all(np.isfinite(swing_reach_all[part_indices])):
+            reach = swing_reach_all[part_indices]
+            lo, hi = float(reach.min()), max(float(reach.max()), float(reach.min()) + 1e-9)
         span = 1.0 if fin.motion == "UNDULATE" else fin.root_blend
         fade = max(span, 1e-3) * (hi - lo)
         weights = group_weights[part_indices].astype(np.float64)

@@ -89,20 +89,15 @@ class SwimRig:
             edges = np.empty((len(obj.data.edges), 2), dtype=np.int32)
             obj.data.edges.foreach_get("vertices", edges.reshape(-1))
             reach = fin_setup.fin_reach(self.rest, edges, in_fin, self.body_length, kn)
-        for index, fin in enumerate(settings.fins):
-            if fin.enabled:
-                self.parts.extend(
-                    fin_setup.build_parts(
-                        index,
-                        fin,
-                        weights[fin.vertex_group],
-                        self.rest,
-                        self.axis_rest,
-                        self.up,
-                        kn,
-                        reach,
-                    )
-                )
+        self.parts = self._build_parts(settings, weights, reach)
+        # Swinging fins (FLAP, UP_DOWN) fade in over a reach squashed across their lines
+        # (docs/algorithms.md §2.4): bound again with it, same roots and tips.
+        squash = fin_setup.swing_squash(self.parts, settings.fins, self.count)
+        if reach is not None and squash is not None:
+            swing_reach = fin_setup.fin_reach(
+                self.rest, edges, in_fin, self.body_length, kn, squash
+            )
+            self.parts = self._build_parts(settings, weights, reach, swing_reach)
         # Four probe points per fin part (root and one step along its tangent, side, up):
         # deformed with the body they give the body's rotation at the root.
         arm = PROBE_SCALE * self.body_length
@@ -119,6 +114,25 @@ class SwimRig:
             self.probes_rest = np.ascontiguousarray(probes, dtype=np.float32)
             self.probe_binding = kn.ffd_bind(self.axis_rest, self.probes_rest, up=self.up)
             self.probes_out = np.empty_like(self.probes_rest)
+
+    def _build_parts(self, settings, weights, reach, swing_reach=None):
+        parts = []
+        for index, fin in enumerate(settings.fins):
+            if fin.enabled:
+                parts.extend(
+                    fin_setup.build_parts(
+                        index,
+                        fin,
+                        weights[fin.vertex_group],
+                        self.rest,
+                        self.axis_rest,
+                        self.up,
+                        self.kn,
+                        reach,
+                        swing_reach,
+                    )
+                )
+        return parts
 
     def bend_direction(self, settings):
         return self.up if settings.bend == "DORSOVENTRAL" else self.side

@@ -73,6 +73,21 @@ Vec3 unit_cross_or(const Vec3& a, const Vec3& b, const Vec3& fallback) {
 
 }  // namespace
 
+Vec3 swing_hinge(FinMotion motion, const Vec3& outward, const RootFrame& frame) {
+  const Vec3 n = outward.normalized();
+  switch (motion) {
+    case FinMotion::Flap:
+      return unit_cross_or(n, frame.tangent, frame.up);
+    case FinMotion::UpDown:
+      return std::abs(n.dot(frame.tangent.normalized())) > Real(0.95) ? Vec3(frame.side.normalized())
+                                                                     : Vec3(frame.tangent.normalized());
+    case FinMotion::Twist:
+    case FinMotion::Undulate:
+      break;
+  }
+  return Vec3::Zero();
+}
+
 FinPartBinding::FinPartBinding(const Vec3List& points, const std::vector<Real>& reach,
                                const std::vector<Real>& weight_in, const FinPartRest& rest, Real fade)
     : reach_(reach), weight_(weight_in), group_(weight_in), rest_(rest), fade_(std::max(fade, Real(0))) {
@@ -120,7 +135,7 @@ void FinPartBinding::displace(const FinWave& wave, Real phase, const Mat3& body_
   Real angle = 0, roll = 0, undulation = 0;
   switch (wave.motion) {
     case FinMotion::Flap: {
-      hinge_axis = unit_cross_or(outward, f.tangent, f.up);
+      hinge_axis = swing_hinge(wave.motion, outward, f);
       angle = wave.amplitude * std::sin(phase);
       const Real toward = wave.feather_on_power ? Real(1) + std::cos(phase) : Real(1) - std::cos(phase);
       // Not held here: a rowing blade must turn edge-on (the caller holds feathering on
@@ -129,7 +144,7 @@ void FinPartBinding::displace(const FinWave& wave, Real phase, const Mat3& body_
       break;
     }
     case FinMotion::UpDown:
-      hinge_axis = std::abs(outward.dot(f.tangent)) > Real(0.95) ? f.side.normalized() : f.tangent.normalized();
+      hinge_axis = swing_hinge(wave.motion, outward, f);
       angle = wave.amplitude * std::sin(phase);
       break;
     case FinMotion::Twist:

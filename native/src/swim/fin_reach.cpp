@@ -1,6 +1,7 @@
 #include "kodawari/swim/fin_reach.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <limits>
 #include <numeric>
@@ -93,7 +94,9 @@ std::vector<Real> nearest_distances(const float* points, std::size_t count, cons
 
 std::vector<Real> fin_reach(const float* vertices, std::size_t count, const std::int32_t* edges,
                             std::size_t edge_count, const std::uint8_t* in_fin, Real seed_radius,
-                            std::vector<std::int64_t>* source, unsigned threads) {
+                            std::vector<std::int64_t>* source, unsigned threads, const float* squash,
+                            Real squash_factor) {
+  if (!(squash_factor >= 0 && squash_factor <= 1)) throw std::invalid_argument("squash_factor must be in [0, 1]");
   for (std::size_t e = 0; e < 2 * edge_count; ++e) {
     if (edges[e] < 0 || static_cast<std::size_t>(edges[e]) >= count) {
       throw std::invalid_argument("edges holds vertex index " + std::to_string(edges[e]) + ", out of range");
@@ -121,10 +124,25 @@ std::vector<Real> fin_reach(const float* vertices, std::size_t count, const std:
     for (std::size_t k = begin; k < end; ++k) reach[fins[k]] = tree.nearest(point(fins[k]), seed_radius);
   });
   // ... and fin vertices joined to the body by an edge (a welded fin).
+  // An edge's length with its extent across the part's outward direction counted
+  // squash_factor times (in the shorter of its two ends' metrics, so the reach's growth
+  // across the outward direction is bounded at both ends).
+  const Real keep = squash_factor * squash_factor;
+  auto metric2 = [&](const Vec3& e, std::size_t i) {
+    const Vec3 n(squash[3 * i], squash[3 * i + 1], squash[3 * i + 2]);
+    if (!(n.squaredNorm() > 0)) return e.squaredNorm();
+    const Real along = e.dot(n);
+    return keep * e.squaredNorm() + (Real(1) - keep) * along * along;
+  };
+  auto edge_length = [&](std::size_t a, std::size_t b) {
+    const Vec3 e = point(a) - point(b);
+    if (squash == nullptr) return e.norm();
+    return std::sqrt(std::max(std::min(metric2(e, a), metric2(e, b)), Real(0)));
+  };
   std::vector<std::vector<std::pair<std::int32_t, Real>>> links(count);
   for (std::size_t e = 0; e < edge_count; ++e) {
     const std::int32_t a = edges[2 * e], b = edges[2 * e + 1];
-    const Real length = (point(static_cast<std::size_t>(a)) - point(static_cast<std::size_t>(b))).norm();
+    const Real length = edge_length(static_cast<std::size_t>(a), static_cast<std::size_t>(b));
     if (in_fin[a] && in_fin[b]) {
       links[a].push_back({b, length});
       links[b].push_back({a, length});

@@ -27,6 +27,12 @@ struct FinPartRest {
   Real base_front = 0;       // tangent coordinate of the base's front end
 };
 
+// The unit axis a FLAP or UP_DOWN swing turns a part about (docs/algorithms.md §2.4):
+// FLAP about outward × tangent (the body's up when the fin lies along the body),
+// UP_DOWN about the body's tangent (its side when the fin lies along the body).
+// Zero for TWIST and UNDULATE, which do not swing.
+Vec3 swing_hinge(FinMotion motion, const Vec3& outward, const RootFrame& frame);
+
 class FinPartBinding {
  public:
   // points: M rest positions; reach: M path lengths across the fin from the body
