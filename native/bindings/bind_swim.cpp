@@ -277,12 +277,8 @@ void bind_swim(py::module_& m) {
         const std::size_t n = static_cast<std::size_t>(v.shape(0)), ne = static_cast<std::size_t>(e.shape(0));
         std::vector<float> directions;
         if (!squash.is_none()) {
-          auto q = checked_array<float>(squash, "squash", v.shape(0), 3);
-          directions.assign(q.data(), q.data() + 3 * n);
-          for (std::size_t i = 0; i < n; ++i) {
-            const Real length = Vec3(directions[3 * i], directions[3 * i + 1], directions[3 * i + 2]).norm();
-            if (length > 0 && std::abs(length - 1) > 1e-3) throw py::value_error("squash rows must be unit or zero");
-          }
+          auto q = checked_array<float>(squash, "squash", v.shape(0), 9);
+          directions.assign(q.data(), q.data() + 9 * n);
         }
         std::vector<Real> reach;
         std::vector<std::int64_t> source;
@@ -299,9 +295,9 @@ void bind_swim(py::module_& m) {
       },
       py::arg("vertices"), py::arg("edges"), py::arg("in_fin"), py::arg("seed_radius"), py::arg("squash") = py::none(),
       "(reach float64 (N,), source int64 (N,)): for fin vertices, the path length across the fin from where it "
-      "meets the body (0 elsewhere), and the vertex at the root that path starts from. squash: float32 (N, 3), "
-      "per vertex its swinging part's unit outward direction (zero rows: none): an edge's extent across it "
-      "counts 0.6 times, so the reach grows slowly across the fin's lines.");
+      "meets the body (0 elsewhere), and the vertex at the root that path starts from. squash: float32 (N, 9), "
+      "per vertex a row-major 3x3 projector onto the directions its part's motion moves it in (zero rows: "
+      "none): an edge's extent in them counts 0.6 times, so the reach grows slowly along the motion.");
   py::class_<swim::FinPartBinding, std::shared_ptr<swim::FinPartBinding>>(
       m, "FinPart", "One fin part bound for motion: every vertex swings about its own root point, faded in by weight "
       "(fade > 0: weight × smoothstep(reach / fade), the swing bent along the fin so no line stretches).")
@@ -336,6 +332,17 @@ void bind_swim(py::module_& m) {
       .def_property_readonly("count", &swim::FinPartBinding::count)
       .def_property_readonly("max_roll", &swim::FinPartBinding::max_roll)
       .def_property_readonly("max_undulation", &swim::FinPartBinding::max_undulation)
+      .def(
+          "swing_direction",
+          [](const swim::FinPartBinding& b, const std::string& motion) {
+            const Vec3 d = b.swing_direction(fin_motion_from(motion));
+            py::array_t<double> out(3);
+            std::copy(d.data(), d.data() + 3, out.mutable_data());
+            return out;
+          },
+          py::arg("motion"),
+          "float64 (3,): the unit direction the motion's swing moves this part's lines in (hinge x outward; zero "
+          "for TWIST and UNDULATE).")
 
       .def(
           "displace",

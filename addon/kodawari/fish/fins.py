@@ -94,8 +94,8 @@ def _outward(kind, centroid_offset, frame):
 
 def fin_reach(rest, edges, in_fin, body_length, kn, squash=None):
     """Per vertex: how far across its fin it stands from the body (path length along the
-    fin's edges from where it meets the body; 0 on the body). squash: float32 (N, 3)
-    (swing_squash): the reach then grows slowly across each swinging part's lines, so no
+    fin's edges from where it meets the body; 0 on the body). squash: float32 (N, 9)
+    (swing_squash): the reach then grows slowly along each swinging part's motion, so no
     edge stretches (docs/algorithms.md §2.4). Native."""
     reach, _source = kn.swim_fin_reach(
         np.ascontiguousarray(rest, dtype=np.float32),
@@ -108,15 +108,25 @@ def fin_reach(rest, edges, in_fin, body_length, kn, squash=None):
 
 
 SWINGING = ("FLAP", "UP_DOWN")
+ROWING_KINDS = ("PECTORAL", "PELVIC")  # paired fins row: their FLAP feathers freely
 
 
 def swing_squash(parts, fins, count):
-    """float32 (count, 3): on each swinging part's vertices its unit outward direction
-    (zero elsewhere), for fin_reach's squash; None when no part swings."""
-    squash = np.zeros((count, 3), dtype=np.float32)
+    """float32 (count, 9): per vertex of a swinging part, the projector (3x3, row-major)
+    onto the directions its motion moves it in: the swing direction, and for a rowing
+    fin's FLAP everything across its outward direction (the feathering roll turns the
+    blade about it). Zero elsewhere; None when no part swings. For fin_reach's squash."""
+    squash = np.zeros((count, 9), dtype=np.float32)
     for part in parts:
-        if fins[part.fin_index].motion in SWINGING:
-            squash[part.indices] = part.outward
+        fin = fins[part.fin_index]
+        if fin.motion not in SWINGING:
+            continue
+        if fin.motion == "FLAP" and fin.kind in ROWING_KINDS:
+            projector = np.eye(3) - np.outer(part.outward, part.outward)
+        else:
+            s = part.binding.swing_direction(fin.motion)
+            projector = np.outer(s, s)
+        squash[part.indices] = projector.reshape(-1)
     return squash if squash.any() else None
 
 
@@ -137,7 +147,7 @@ def build_parts(
     fin_index, fin, group_weights, verts, body_axis, up, kn, reach_all=None, swing_reach_all=None
 ):
     """FinParts of one fin setting; raises ValueError with a readable reason.
-    swing_reach_all: fin_reach squashed across each swinging part's lines (swing_squash),
+    swing_reach_all: fin_reach squashed along each swinging part's motion (swing_squash),
     the reach its swing fades in over; the part's root and tip still come from reach_all."""
     indices = np.flatnonzero(group_weights > 0.0)
     if len(indices) < 4:
@@ -183,9 +193,9 @@ def build_parts(
         # root band it would shear the fin's base (its amplitude is a share of the height).
         # The fade is a smoothstep over a share of the fin's own height (not a fixed
         # distance), applied in the core, which also bends the swing along the fin.
-        # A swing fades in over the reach squashed across the fin's lines (swing_reach_all),
-        # which grows at most 0.6 per unit length across them: across a thin fin's two faces
-        # or a fan-shaped tail, a path length growing along the swing stretched edges 1.6x.
+        # A swing fades in over the reach squashed along its motion (swing_reach_all), which
+        # grows at most 0.6 per unit length that way: across a thin fin's two faces or a
+        # fan-shaped tail, a path length growing along the swing stretched edges 1.6x.
         if swing_reach_all is not None and np.all(np.isfinite(swing_reach_all[part_indices])):
             reach = swing_reach_all[part_indices]
             lo, hi = float(reach.min()), max(float(reach.max()), float(reach.min()) + 1e-9)

@@ -27,7 +27,7 @@ def rest_positions(obj):
 
 
 FINGERPRINT_SAMPLES = 32
-ROWING_KINDS = ("PECTORAL", "PELVIC")
+ROWING_KINDS = fin_setup.ROWING_KINDS
 
 
 def rest_fingerprint(obj):
@@ -90,7 +90,7 @@ class SwimRig:
             obj.data.edges.foreach_get("vertices", edges.reshape(-1))
             reach = fin_setup.fin_reach(self.rest, edges, in_fin, self.body_length, kn)
         self.parts = self._build_parts(settings, weights, reach)
-        # Swinging fins (FLAP, UP_DOWN) fade in over a reach squashed across their lines
+        # Swinging fins (FLAP, UP_DOWN) fade in over a reach squashed along their motion
         # (docs/algorithms.md §2.4): bound again with it, same roots and tips.
         squash = fin_setup.swing_squash(self.parts, settings.fins, self.count)
         if reach is not None and squash is not None:

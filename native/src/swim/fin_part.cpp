@@ -88,6 +88,12 @@ Vec3 swing_hinge(FinMotion motion, const Vec3& outward, const RootFrame& frame) 
   return Vec3::Zero();
 }
 
+Vec3 swing_direction(FinMotion motion, const Vec3& outward, const RootFrame& frame) {
+  const Vec3 s = swing_hinge(motion, outward, frame).cross(outward.normalized());
+  const Real norm = s.norm();
+  return norm > Real(1e-9) ? Vec3(s / norm) : Vec3::Zero();
+}
+
 FinPartBinding::FinPartBinding(const Vec3List& points, const std::vector<Real>& reach,
                                const std::vector<Real>& weight_in, const FinPartRest& rest, Real fade)
     : reach_(reach), weight_(weight_in), group_(weight_in), rest_(rest), fade_(std::max(fade, Real(0))) {

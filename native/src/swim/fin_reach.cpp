@@ -124,20 +124,21 @@ std::vector<Real> fin_reach(const float* vertices, std::size_t count, const std:
     for (std::size_t k = begin; k < end; ++k) reach[fins[k]] = tree.nearest(point(fins[k]), seed_radius);
   });
   // ... and fin vertices joined to the body by an edge (a welded fin).
-  // An edge's length with its extent across the part's outward direction counted
-  // squash_factor times (in the shorter of its two ends' metrics, so the reach's growth
-  // across the outward direction is bounded at both ends).
-  const Real keep = squash_factor * squash_factor;
+  // An edge's length with its part in each end's squash subspace (projector P) counted
+  // squash_factor times, the shorter of the two ends' metrics (so the reach's growth in
+  // the subspace is bounded at both ends); never below squash_factor · length.
+  const Real shrink = Real(1) - squash_factor * squash_factor;
   auto metric2 = [&](const Vec3& e, std::size_t i) {
-    const Vec3 n(squash[3 * i], squash[3 * i + 1], squash[3 * i + 2]);
-    if (!(n.squaredNorm() > 0)) return e.squaredNorm();
-    const Real along = e.dot(n);
-    return keep * e.squaredNorm() + (Real(1) - keep) * along * along;
+    const float* p = squash + 9 * i;
+    Real squashed = 0;
+    for (int r = 0; r < 3; ++r) squashed += e[r] * (p[3 * r] * e[0] + p[3 * r + 1] * e[1] + p[3 * r + 2] * e[2]);
+    const Real length2 = e.squaredNorm();
+    return std::clamp(length2 - shrink * squashed, squash_factor * squash_factor * length2, length2);
   };
   auto edge_length = [&](std::size_t a, std::size_t b) {
     const Vec3 e = point(a) - point(b);
     if (squash == nullptr) return e.norm();
-    return std::sqrt(std::max(std::min(metric2(e, a), metric2(e, b)), Real(0)));
+    return std::sqrt(std::min(metric2(e, a), metric2(e, b)));
   };
   std::vector<std::vector<std::pair<std::int32_t, Real>>> links(count);
   for (std::size_t e = 0; e < edge_count; ++e) {

@@ -33,6 +33,10 @@ struct FinPartRest {
 // Zero for TWIST and UNDULATE, which do not swing.
 Vec3 swing_hinge(FinMotion motion, const Vec3& outward, const RootFrame& frame);
 
+// The unit direction a swing moves the part's lines in (hinge × outward); zero when the
+// motion does not swing.
+Vec3 swing_direction(FinMotion motion, const Vec3& outward, const RootFrame& frame);
+
 class FinPartBinding {
  public:
   // points: M rest positions; reach: M path lengths across the fin from the body
@@ -47,6 +51,9 @@ class FinPartBinding {
   // Writes M displacements (xyz floats) of the part for a phase, turned by
   // `body_rotation` (the body's rotation at the root, rest → now).
   void displace(const FinWave& wave, Real phase, const Mat3& body_rotation, float* out) const;
+
+  // swing_direction for this part.
+  Vec3 swing_direction(FinMotion motion) const { return swim::swing_direction(motion, rest_.outward, rest_.frame); }
 
   // The largest roll (twist / feathering) and undulation amplitude (length units)
   // the fade allows without shearing the mesh by more than 0.35.

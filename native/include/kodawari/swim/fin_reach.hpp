@@ -25,12 +25,13 @@ std::vector<Real> nearest_distances(const float* points, std::size_t count, cons
 // part with no path to the body gets its straight distance to the nearest body vertex.
 // `source` (optional) receives, per vertex, the vertex its path starts from: the body
 // vertex (or seed fin vertex) at the fin's root below it; itself for body vertices.
-// `squash` (optional, count float xyz triples, unit or zero): per vertex, its part's
-// outward direction (root → tip) when the part swings; an edge's extent ACROSS that
-// direction counts only `squash_factor` times (in the shorter of its two ends' metrics;
-// zero rows: the plain length), so the reach grows at most squash_factor per unit length
-// across the fin's lines (docs/algorithms.md §2.4: a reach growing along the swing or the
-// feathering roll, as across a thin fin's two faces or a fan-shaped tail, stretched edges 1.6×).
+// `squash` (optional, count row-major 3×3 float projectors, zero = none): per vertex, the
+// directions its part's motion moves it in, across the fin's lines (fish/fins.py: the
+// swing direction, or everything across the outward direction for a fin that feathers);
+// an edge's extent in them counts only `squash_factor` times (in the shorter of its two
+// ends' metrics), so the reach grows at most squash_factor per unit length along the
+// motion (docs/algorithms.md §2.4: a reach growing along the swing, as across a thin
+// fin's two faces or a fan-shaped tail, stretched edges 1.6× at 0.6 rad).
 std::vector<Real> fin_reach(const float* vertices, std::size_t count, const std::int32_t* edges,
                             std::size_t edge_count, const std::uint8_t* in_fin, Real seed_radius,
                             std::vector<std::int64_t>* source = nullptr, unsigned threads = 0,
