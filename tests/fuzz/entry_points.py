@@ -257,11 +257,14 @@ def _axis_coordinates_args():
 
 def _fin_reach_args():
     vertices, edges, fin, _ = _disc()
+    squash = np.zeros((len(vertices), 9), dtype=np.float32)
+    squash[fin] = np.outer([1.0, 0, 0], [1.0, 0, 0]).reshape(-1)
     return {
         "vertices": vertices.copy(),
         "edges": edges.copy(),
         "in_fin": fin.copy(),
         "seed_radius": 1e-6,
+        "squash": squash,
     }
 
 
@@ -420,6 +423,12 @@ TARGETS = [
         _method(_fin_part, "displace"),
         outputs=("out",),
         examples=80,
+    ),
+    Target(
+        "FinPart.swing_direction",
+        lambda: {"motion": "FLAP"},
+        _method(_fin_part, "swing_direction"),
+        examples=20,
     ),
     Target("FinPart.count", dict, lambda: _fin_part().count, examples=1),
     Target("FinPart.max_roll", dict, lambda: _fin_part().max_roll, examples=1),

@@ -195,6 +195,51 @@ def test_nearest_distances_and_fin_reach():
     assert np.allclose(rows[:, 0], 0.012 * np.arange(1, 6), atol=1e-6)
 
 
+def test_fin_reach_squashed_grows_slowly_along_the_motion():
+    # A swinging fin's fade is measured with edges counted 0.6 times along its motion
+    # (docs/algorithms.md §2.4), so its reach grows at most 0.6 per unit length that way.
+    vertices, edges, fin = _disc_fish()
+    plain, _ = kn.swim_fin_reach(vertices, edges, fin, 1e-6)
+    along_z = np.zeros((len(vertices), 9), dtype=np.float32)
+    along_z[fin] = np.outer([0, 0, 1], [0, 0, 1]).reshape(-1)
+    squashed, _ = kn.swim_fin_reach(vertices, edges, fin, 1e-6, along_z)
+    rows = squashed[fin].reshape(5, -1)
+    assert np.allclose(rows[:, 0], 0.6 * 0.012 * np.arange(1, 6), atol=1e-6)
+    # The plate's rows run along z: squashing along x leaves them; zero rows squash nothing.
+    along_x = np.zeros_like(along_z)
+    along_x[fin] = np.outer([1, 0, 0], [1, 0, 0]).reshape(-1)
+    assert np.allclose(kn.swim_fin_reach(vertices, edges, fin, 1e-6, along_x)[0], plain)
+    none = np.zeros_like(along_z)
+    assert np.array_equal(kn.swim_fin_reach(vertices, edges, fin, 1e-6, none)[0], plain)
+    # Along every edge the reach changes by at most the edge's squashed length.
+    e = vertices[edges[:, 0]].astype(np.float64) - vertices[edges[:, 1]]
+    bound = np.sqrt((e**2).sum(axis=1) - 0.64 * e[:, 2] ** 2)
+    assert (np.abs(squashed[edges[:, 0]] - squashed[edges[:, 1]]) <= bound + 1e-6).all()
+    with pytest.raises(ValueError, match="squash"):
+        kn.swim_fin_reach(vertices, edges, fin, 1e-6, along_z[:, :3].copy())
+
+
+def test_fin_part_swing_direction():
+    part = kn.FinPart(
+        np.zeros((4, 3), np.float32),
+        np.linspace(0, 0.1, 4),
+        np.ones(4),
+        np.zeros(3),
+        np.array([0.0, 0.0, 1.0]),  # outward: up (a dorsal fin)
+        np.array([1.0, 0.0, 0.0]),  # tangent
+        np.array([0.0, 1.0, 0.0]),
+        np.array([0.0, 0.0, 1.0]),
+        0.1,
+        0.2,
+        0.0,
+    )
+    # FLAP turns about outward x tangent (y): the lines move along the body (x);
+    # UP_DOWN turns about the tangent: they move sideways; TWIST and UNDULATE do not swing.
+    assert np.allclose(np.abs(part.swing_direction("FLAP")), [1, 0, 0])
+    assert np.allclose(np.abs(part.swing_direction("UP_DOWN")), [0, 1, 0])
+    assert not part.swing_direction("TWIST").any() and not part.swing_direction("UNDULATE").any()
+
+
 def test_fin_part_swings_each_vertex_about_its_own_root():
     heights = np.repeat(np.linspace(0.0, 0.1, 6), 5)
     along = np.tile(np.linspace(0.0, 0.2, 5), 6)
