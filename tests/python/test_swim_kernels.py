@@ -219,6 +219,73 @@ def test_fin_reach_squashed_grows_slowly_along_the_motion():
         kn.swim_fin_reach(vertices, edges, fin, 1e-6, along_z[:, :3].copy())
 
 
+def _fan_tail(rays=17, rows=16, root_radius=0.02, step=0.01, half_angle=1.4):
+    """A fan-shaped tail in the xz plane behind a small root arc (body vertices): rays
+    spread +-80 degrees, so the reach grows along z (a pitching tail's swing direction)."""
+    phis = np.linspace(-half_angle, half_angle, rays)
+    radii = root_radius + step * np.arange(rows + 1)
+    points = np.stack(
+        [-np.outer(radii, np.cos(phis)), np.zeros((rows + 1, rays)), np.outer(radii, np.sin(phis))],
+        axis=2,
+    ).reshape(-1, 3)
+    grid = np.arange(len(points)).reshape(rows + 1, rays)
+    edges = np.concatenate(
+        [
+            np.stack([grid[:-1].ravel(), grid[1:].ravel()], axis=1),
+            np.stack([grid[:, :-1].ravel(), grid[:, 1:].ravel()], axis=1),
+        ]
+    ).astype(np.int32)
+    fin = np.ones(len(points), dtype=bool)
+    fin[grid[0]] = False
+    return np.ascontiguousarray(points, dtype=np.float32), edges, fin
+
+
+def _worst_pitch_stretch(vertices, edges, fin, reach):
+    part = np.flatnonzero(fin)
+    r = np.ascontiguousarray(reach[part])
+    tail = kn.FinPart(
+        np.ascontiguousarray(vertices[part]),
+        r,
+        np.ones(len(part)),
+        np.zeros(3),
+        np.array([-1.0, 0.0, 0.0]),  # outward: straight back, along the body (a caudal fin)
+        np.array([-1.0, 0.0, 0.0]),
+        np.array([0.0, 1.0, 0.0]),
+        np.array([0.0, 0.0, 1.0]),
+        float(r.max()),
+        0.01,
+        0.0,
+        0.35 * float(r.max()),
+    )
+    probes = np.ascontiguousarray([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]], dtype=np.float32)
+    out = np.zeros((len(part), 3), dtype=np.float32)
+    rest = np.linalg.norm(vertices[edges[:, 0]] - vertices[edges[:, 1]], axis=1)
+    worst = 0.0
+    for phase in np.linspace(0.0, 2 * np.pi, 25):
+        tail.displace("UP_DOWN", 0.6, phase, 0.0, 1.0, False, probes, probes, out)
+        moved = vertices.astype(np.float64)
+        moved[part] += out
+        now = np.linalg.norm(moved[edges[:, 0]] - moved[edges[:, 1]], axis=1)
+        worst = max(worst, float((now / rest).max()))
+    return worst, tail
+
+
+def test_a_fan_tail_pitching_fades_in_over_the_squashed_reach_without_stretching():
+    # The reach grows radially across a fan, i.e. along the pitch's swing (z): faded in
+    # over it, the swing stretches the fan's edges past 1.5x at 0.6 rad; over the reach
+    # squashed along the swing, well under (docs/algorithms.md §2.4).
+    vertices, edges, fin = _fan_tail()
+    plain, _ = kn.swim_fin_reach(vertices, edges, fin, 1e-6)
+    stretch, tail = _worst_pitch_stretch(vertices, edges, fin, plain)
+    assert stretch > 1.5
+    swing = tail.swing_direction("UP_DOWN")
+    squash = np.zeros((len(vertices), 9), dtype=np.float32)
+    squash[fin] = np.outer(swing, swing).reshape(-1)
+    squashed, _ = kn.swim_fin_reach(vertices, edges, fin, 1e-6, squash)
+    assert _worst_pitch_stretch(vertices, edges, fin, squashed)[0] < 1.4
+    assert (squashed[~fin] == 0).all()  # the root still never moves
+
+
 def test_fin_part_swing_direction():
     part = kn.FinPart(
         np.zeros((4, 3), np.float32),
