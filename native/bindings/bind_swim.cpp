@@ -331,6 +331,7 @@ void bind_swim(py::module_& m) {
            py::arg("base_front"), py::arg("fade") = 0.0)
       .def_property_readonly("count", &swim::FinPartBinding::count)
       .def_property_readonly("max_roll", &swim::FinPartBinding::max_roll)
+      .def_property_readonly("max_feather", &swim::FinPartBinding::max_feather)
       .def_property_readonly("max_undulation", &swim::FinPartBinding::max_undulation)
       .def(
           "swing_direction",

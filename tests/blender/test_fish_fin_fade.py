@@ -18,10 +18,12 @@ def _edges(obj):
 
 
 def _swing(still, moving, mask, rest):
-    """How far the fin's motion carries its vertices (largest move over the frames beside
-    the same frames with the fins still), as a share of the fin's size."""
-    size = np.linalg.norm(rest[mask].max(axis=0) - rest[mask].min(axis=0))
-    return float(np.linalg.norm(moving[:, mask] - still[:, mask], axis=2).max() / size)
+    """The fin's largest move over the frames (beside the same frames with the fins
+    still) as a share of its height (how far its vertices stand from the body)."""
+    from kodawari import native
+
+    height = native.module().swim_nearest_distances(rest[mask], rest[~mask]).max()
+    return float(np.linalg.norm(moving[:, mask] - still[:, mask], axis=2).max() / height)
 
 
 def _max_stretch(rest, positions, edges):
@@ -30,7 +32,9 @@ def _max_stretch(rest, positions, edges):
     return float((after / np.maximum(before, 1e-12)).max())
 
 
-@pytest.mark.parametrize("form", ["spindle", "cetacean"])
+# The issue's shapes: goldfish (deep), dolphin (cetacean, flukes), shark; and a tuna
+# (spindle), a flat catfish-like and an eel: smooth (subdivided twice) and low-poly.
+@pytest.mark.parametrize("form", ["spindle", "cetacean", "deep", "shark", "flat", "eel"])
 @pytest.mark.parametrize("subdivisions", [2, 0])
 def test_no_edge_stretches_past_one_and_a_half_for_any_fin_motion(empty_scene, form, subdivisions):
     set_fps(24)
@@ -61,9 +65,9 @@ def test_no_edge_stretches_past_one_and_a_half_for_any_fin_motion(empty_scene, f
             fin.feathering = 0.5 if motion == "FLAP" else 0.0
         moving = frames(obj, range(1, 13))
         worst[motion] = _max_stretch(co, moving, edges)
-        swing[motion] = min(_swing(still, moving, m, co) for m in masks.values())
+        swing[motion] = [_swing(still, moving, m, co) for m in masks.values()]
     assert max(worst.values()) <= 1.5, worst
-    # ... and every fin still beats (not held still to keep its edges short): measured
-    # 0.06-0.29 of the group's extent (a pair of pectoral fins, a long-based dorsal); the
-    # smallest is the same without the squashed fade (docs/algorithms.md §2.4).
-    assert min(swing["FLAP"], swing["UP_DOWN"]) >= 0.05, swing
+    # ... and every fin still beats (not held still to keep its edges short): a swing of
+    # 0.6 rad rigid about the root moves the rim by 0.59 of the fin's height; measured
+    # 0.14-1.3 here, the smallest the same as before the fade was squashed (§2.4).
+    assert min(swing["FLAP"] + swing["UP_DOWN"]) >= 0.1, swing

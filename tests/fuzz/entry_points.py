@@ -432,6 +432,7 @@ TARGETS = [
     ),
     Target("FinPart.count", dict, lambda: _fin_part().count, examples=1),
     Target("FinPart.max_roll", dict, lambda: _fin_part().max_roll, examples=1),
+    Target("FinPart.max_feather", dict, lambda: _fin_part().max_feather, examples=1),
     Target("FinPart.max_undulation", dict, lambda: _fin_part().max_undulation, examples=1),
     # --- rod
     Target(

@@ -165,11 +165,12 @@ class SwimRig:
             if fin.amplitude == 0.0 and (fin.motion != "FLAP" or fin.feathering == 0.0):
                 continue
             feathering = fin.feathering * part.feather_sign
-            if fin.kind not in ROWING_KINDS:
-                # Only paired fins row; a feathered dorsal, anal or caudal fin would yaw
-                # its long base (docs/algorithms.md §2.4): held like a twist.
-                limit = part.binding.max_roll
-                feathering = max(-limit, min(limit, feathering))
+            # Only paired fins row; a feathered dorsal, anal or caudal fin would yaw its
+            # long base (docs/algorithms.md §2.4): held like a twist. A rowing blade turns
+            # further, held only where its fade is short beside its width (a stubby fin).
+            rowing = fin.kind in ROWING_KINDS
+            limit = part.binding.max_feather if rowing else part.binding.max_roll
+            feathering = max(-limit, min(limit, feathering))
             # The core swings each vertex about its own root, faded in from the body, and
             # turns the result with the body's rotation at the root (from the probes).
             part.binding.displace(

@@ -15,6 +15,8 @@ namespace kodawari::swim {
 namespace {
 
 constexpr Real kMaxShear = 0.35;
+// A rowing fin's feathering (docs/algorithms.md §2.4): with the swing, under 1.5× at 0.6 rad.
+constexpr Real kMaxRowingShear = 0.85;
 // An undulation's steepest slope (wave along the base and fade across the fin together).
 constexpr Real kMaxUndulationSlope = 0.8;
 constexpr int kFadeSamples = 64;
@@ -131,6 +133,7 @@ FinPartBinding::FinPartBinding(const Vec3List& points, const std::vector<Real>& 
     roll_lever = std::max(roll_lever, g * std::max(across_[a].norm(), across_[b].norm()));
   }
   max_roll_ = roll_lever > 0 ? kMaxShear / roll_lever : kPi;
+  max_feather_ = roll_lever > 0 ? kMaxRowingShear / roll_lever : kPi;
   max_undulation_ = slope > 0 ? kMaxShear / slope : rest_.height;
 }
 

@@ -58,6 +58,10 @@ class FinPartBinding {
   // The largest roll (twist / feathering) and undulation amplitude (length units)
   // the fade allows without shearing the mesh by more than 0.35.
   Real max_roll() const { return max_roll_; }
+  // The largest feathering roll of a rowing fin (pectoral, pelvic): a looser shear, 0.85,
+  // since a rowing blade must turn nearly edge-on; still held on a stubby fin whose fade
+  // is short beside its width (a 0.5 rad roll stretched a small eel pectoral 1.9×).
+  Real max_feather() const { return max_feather_; }
   Real max_undulation() const { return max_undulation_; }
 
  private:
@@ -65,7 +69,7 @@ class FinPartBinding {
   std::vector<Real> reach_, weight_, group_, along_, height_;
   FinPartRest rest_;
   Real fade_ = 0;
-  Real max_roll_ = 0, max_undulation_ = 0;
+  Real max_roll_ = 0, max_feather_ = 0, max_undulation_ = 0;
 };
 
 // Nearest rotation to the map taking the rest probe arms to the current ones
