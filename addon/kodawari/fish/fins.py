@@ -5,8 +5,10 @@ its path across the fin from where it meets the body (fin_reach, native); the
 fin's motion swings every vertex about its own root point by that reach, faded
 in from 0 at the root (so root vertices move exactly with the body and the fin
 never tears from it) to the full motion over the first root_blend of the fin
-(an undulating fin: over its whole height). The core (kodawari_native.FinPart)
-turns the motion with the body's rotation at the fin root every frame.
+(an undulating fin: over its whole height). A swinging fin (FLAP, UP_DOWN) fades
+in over a reach that grows slowly along its motion (swing_squash), so no edge
+stretches past 1.5x. The core (kodawari_native.FinPart) turns the motion with the
+body's rotation at the fin root every frame.
 """
 
 import numpy as np
