@@ -35,18 +35,15 @@ constexpr Real kMaxTension = 1.0;
 // ... or when gravity alone would drop a joint by more than this many bone lengths in one.
 constexpr Real kMaxDrop = 0.15;
 constexpr int kMaxSplit = 32;
-// Shape matching is a spring of κ per unit mass on the energy U = (κ/3) Σ_c U_c (§3.3). The UI's
-// stiffness σ is the step it takes in one substep at the default rate (96 Hz): κ = σ · 96² 1/s²,
-// whatever the substeps, iterations and splits. A substep is split while κΔt² > kMaxStiffnessStep
-// (σ = 1 at fewer than 4 substeps): a larger step is no longer a gradient step on U.
-constexpr Real kStiffnessRate = 96.0;
-constexpr Real kMaxStiffnessStep = 1.0;
-inline Real shape_stiffness(Real sigma) { return sigma * kStiffnessRate * kStiffnessRate; }
-// Internal friction of the strand (1/s), applied once per frame: deformation rates within each
-// shape-matching group decay at this rate, the chain's rigid swing does not (rod_simulate.cpp,
-// §3.3). Measured over 4 s at every corner of the UI's ranges: 5 leaves two 2-bone corners
-// gaining 6e-5 J in a frame, 2.5 six corners up to 0.05 J.
-constexpr Real kInternalFriction = 5.0;
+// Stiffness per unit mass (1/s²) that the shape-matching fraction of a substep stands for,
+// read as one implicit Euler step of a spring (s = κΔt² / (1 + κΔt²)): the coefficient of the
+// shape-matching energy (rod_energy.cpp). The fraction compounds over the iterations; a
+// fraction of 1 is a hard constraint, read as 0.99.
+inline Real shape_stiffness(const RodParams& p) {
+  const Real dt = 1 / (kSubstepUnit * Real(p.substeps));
+  const Real left = std::max(std::pow(Real(1) - p.stiffness, Real(p.iterations)), Real(0.01));
+  return (1 - left) / (left * dt * dt);
+}
 // Rods per work chunk (threads take chunks as they go): about 0.2 ms of work at 16 bones.
 constexpr std::size_t kRodsPerChunk = 16;
 

@@ -32,8 +32,7 @@ RodEnergy RodSystem::energy(std::size_t r, const Vec3& gravity) const {
     out.kinetic += Real(0.5) * s.v[j].squaredNorm();
     out.gravitational -= g.dot(s.x[j]);
   }
-  // The root particle's orientation weighs kKinematicWeight in every fit, so its inertia does too.
-  for (std::size_t j = 1; j < count; ++j) out.kinetic += (j == 1 ? kKinematicWeight : Real(1)) * e * s.omega[j].squaredNorm();
+  for (std::size_t j = 1; j < count; ++j) out.kinetic += e * s.omega[j].squaredNorm();
 
   // Shape matching: each group's distance from its best rigid fit, the quantity whose
   // minimiser R the solver extracts (Müller & Chentanez 2011, Müller et al. 2005):
@@ -42,7 +41,7 @@ RodEnergy RodSystem::energy(std::size_t r, const Vec3& gravity) const {
   // (x_i - g_ci); the solver moves it by the average of those, a fraction s of the way per
   // substep, which is one implicit Euler step of a spring κ per unit mass when
   // s = κΔt²/(1 + κΔt²) (rod_detail.hpp): hence U = (κ / 3) Σ_c U_c.
-  const Real kappa = shape_stiffness(rod.params.stiffness);
+  const Real kappa = shape_stiffness(rod.params);
   Real groups = 0;
   for (std::size_t c = 1; c < count; ++c) {
     const std::size_t lo = c - 1;

@@ -22,7 +22,7 @@ namespace {
 struct SimulationScratch {
   Vec3List x_rest;
   QuatList q_rest, q_rest_conjugate, new_q;
-  std::vector<Real> lengths, inverse_mass, projection;
+  std::vector<Real> lengths, inverse_hits, inverse_mass, projection;
   // Per group c (members c-1, c, c+1 clipped to the chain): member weights w_i / mass,
   // rest offsets from the rest centroid r_i = x̄_i - c̄, and w_i r_i (so that
   // A = Σ w_i (x_i - c)(x̄_i - c̄)ᵀ = Σ x_i (w_i r_i)ᵀ, because Σ w_i r_i = 0).
@@ -30,8 +30,8 @@ struct SimulationScratch {
   std::vector<Real> group_ellipsoid; // 3 per group: w_i e (groups with a kinematic member)
   Vec3List group_rest, group_weighted_rest;  // 3 per group
   std::vector<Mat3, Eigen::aligned_allocator<Mat3>> orientation_terms;
-  QuatList orientation_quats, group_rotations;
-  Vec3List displacement, dv, dw;
+  QuatList orientation_quats;
+  Vec3List displacement;
 };
 
 SimulationScratch& simulation_scratch() {
@@ -42,67 +42,6 @@ SimulationScratch& simulation_scratch() {
 // The rotation matrix of a unit quaternion (as Eigen's toRotationMatrix, inlined here).
 inline Mat3 rotation_matrix(const Quat& q) {
   return q.toRotationMatrix();
-}
-
-// Internal friction (docs/algorithms.md §3.3): within every shape-matching group the members'
-// velocities and spins are pulled toward the group's rigid motion (the velocity damping of
-// Müller et al. 2007, §3.5, applied per group), the kinematic ghost and root moving as the
-// parent bone does. Each group's step is an orthogonal projection in the kinetic-energy metric
-// (unit mass, spin inertia 2e; the root's spin kKinematicWeight times that) and every particle
-// takes a third of its groups' steps, so the pass only removes energy and keeps the rigid
-// swing of the chain.
-void internal_friction(const Vec3* x, Vec3* v, Vec3* omega, std::size_t count, const Vec3& anchor_velocity,
-                       const Vec3& anchor_spin, Real e, Real fraction, Vec3List& dv, Vec3List& dw) {
-  dv.assign(count, Vec3::Zero());
-  dw.assign(count, Vec3::Zero());
-  for (std::size_t c = 1; c < count; ++c) {
-    const std::size_t lo = c - 1, hi = std::min(c + 1, count - 1);
-    Vec3 centre, velocity, spin;
-    if (lo <= 1) {
-      // A kinematic member: the group's rigid motion is the parent's, about the root joint.
-      // Group 1 holds ghost and root (fully kinematic); group 2 holds the root only: its
-      // motion about the root is the spin that best fits its dynamic members.
-      centre = x[1];
-      velocity = anchor_velocity;
-      spin = anchor_spin;
-      if (lo == 1) {
-        Vec3 momentum = kKinematicWeight * 2 * e * omega[1];
-        Mat3 inertia = kKinematicWeight * 2 * e * Mat3::Identity();
-        for (std::size_t i = 2; i <= hi; ++i) {
-          const Vec3 r = x[i] - centre;
-          momentum += r.cross(v[i] - velocity) + 2 * e * omega[i];
-          inertia += (r.squaredNorm() + 2 * e) * Mat3::Identity() - r * r.transpose();
-        }
-        spin = inertia.ldlt().solve(momentum);
-      }
-    } else {
-      const Real mass = Real(hi - lo + 1);
-      centre = Vec3::Zero();
-      velocity = Vec3::Zero();
-      for (std::size_t i = lo; i <= hi; ++i) {
-        centre += x[i];
-        velocity += v[i];
-      }
-      centre /= mass;
-      velocity /= mass;
-      Vec3 momentum = Vec3::Zero();
-      Mat3 inertia = Mat3::Zero();
-      for (std::size_t i = lo; i <= hi; ++i) {
-        const Vec3 r = x[i] - centre;
-        momentum += r.cross(v[i] - velocity) + 2 * e * omega[i];
-        inertia += (r.squaredNorm() + 2 * e) * Mat3::Identity() - r * r.transpose();
-      }
-      spin = inertia.ldlt().solve(momentum);
-    }
-    for (std::size_t i = std::max<std::size_t>(lo, 1); i <= hi; ++i) {
-      if (i >= 2) dv[i] += velocity + spin.cross(x[i] - centre) - v[i];
-      dw[i] += spin - omega[i];
-    }
-  }
-  for (std::size_t i = 1; i < count; ++i) {
-    if (i >= 2) v[i] += fraction * dv[i];
-    omega[i] += fraction * dw[i];
-  }
 }
 
 }  // namespace
@@ -151,6 +90,9 @@ void RodSystem::simulate(std::size_t r, const FrameInput& input, const std::vect
     mean /= Real(n);
     return (mean * mean) / 5;  // a sphere of radius one segment: a²/5
   }();
+  // Particle j >= 2 belongs to the groups j-1, j and j+1 (those that exist): the Jacobi average.
+  w.inverse_hits.assign(count, Real(0));
+  for (std::size_t j = 2; j < count; ++j) w.inverse_hits[j] = Real(1) / Real(j + 1 < count ? 3 : 2);
   w.group_weights.assign(3 * count, Real(0));
   w.group_ellipsoid.assign(3 * count, Real(0));
   w.group_rest.assign(3 * count, Vec3::Zero());
@@ -180,7 +122,6 @@ void RodSystem::simulate(std::size_t r, const FrameInput& input, const std::vect
   const Vec3 gravity = world_to_armature * (input.gravity * p.gravity);
   const Real base_dt = 1 / rate;
   const Real min_length = *std::min_element(w.lengths.begin(), w.lengths.end());
-  const Real kappa = shape_stiffness(p.stiffness);
   // The root's velocity over this frame (the kinematic end of the first bone).
   const Real frame_time = steps > 0 ? Real(steps) * base_dt : Real(1);
   const Vec3 anchor_velocity = (anchor_end - anchor_start) / frame_time;
@@ -188,7 +129,7 @@ void RodSystem::simulate(std::size_t r, const FrameInput& input, const std::vect
   w.orientation_terms.resize(count);
   w.orientation_quats.resize(count);
   w.displacement.resize(count);
-  w.group_rotations.resize(count);
+  w.new_q.resize(count);
   Vec3* x = s.x.data();
   Quat* q = s.q.data();
   for (long step = 1; step <= steps; ++step) {
@@ -196,7 +137,8 @@ void RodSystem::simulate(std::size_t r, const FrameInput& input, const std::vect
     // substep: beyond that the length projection's linearisation no longer sees the motion it
     // corrects (its corrections add up along the chain: on long chains of short bones a
     // whipping tip outruns it at the base rate). A chain carried along whole by the root
-    // needs no split. Such substeps are split; the shape-matching spring κ stays (§3.3).
+    // needs no split. Such substeps are split; the shape-matching fraction is rescaled so
+    // the stiffness per base substep stays.
     Real fastest = 0;
     for (std::size_t j = 2; j < count; ++j) fastest = std::max(fastest, (s.v[j] - anchor_velocity).squaredNorm());
     const Real travel = (std::sqrt(fastest) + gravity.norm() * base_dt) * base_dt;
@@ -207,14 +149,12 @@ void RodSystem::simulate(std::size_t r, const FrameInput& input, const std::vect
     const Real drop = gravity.norm() * base_dt * base_dt;
     const Real split_needed =
         std::max({std::ceil(travel / (kMaxTravel * min_length)), std::ceil(std::sqrt(drop / (kMaxDrop * min_length))),
-                  std::ceil(std::sqrt(Real(n) * drop / (kMaxTension * min_length))),
-                  std::ceil(std::sqrt(kappa / kMaxStiffnessStep) * base_dt - Real(1e-9))});
+                  std::ceil(std::sqrt(Real(n) * drop / (kMaxTension * min_length)))});
     const int split = static_cast<int>(std::clamp(split_needed, Real(1), Real(kMaxSplit)));
     const Real dt = base_dt / Real(split);
     const Real inverse_dt = 1 / dt;
     const Real decay = std::exp(-p.damping * dt);
-    // The shape-matching step of one substep: a third of κΔt² of each group's pull (below).
-    const Real stiffness = std::min(Real(1), kappa * dt * dt) / 3;
+    const Real stiffness = split == 1 ? p.stiffness : Real(1) - std::pow(Real(1) - p.stiffness, Real(1) / Real(split));
     for (int sub = 1; sub <= split; ++sub) {
       const Real f = (Real(step - 1) + Real(sub) / Real(split)) / Real(steps);
       const Vec3 anchor = anchor_start + f * (anchor_end - anchor_start);
@@ -238,9 +178,7 @@ void RodSystem::simulate(std::size_t r, const FrameInput& input, const std::vect
         if (windy) a += kWindDrag * (wind - s.v[j]);
         s.v[j] = decay * s.v[j] + dt * a;
         s.prev_x[j] = x[j];
-        // Gravity's share of the move (Δt² g) is added after the shape matching, so that the
-        // matching pulls at x + Δt v and a strand at rest sits where κ ∇U balances g (§3.3).
-        x[j] += dt * s.v[j] - (dt * dt) * gravity;
+        x[j] += dt * s.v[j];
       }
       for (std::size_t j = 1; j < count; ++j) {
         s.omega[j] *= decay;
@@ -248,10 +186,8 @@ void RodSystem::simulate(std::size_t r, const FrameInput& input, const std::vect
         q[j] = spin(q[j], s.omega[j] * dt);
       }
 
-      {
-        // Shape matching over each particle's neighbourhood {c-1, c, c+1}, once per substep:
-        // every particle moves by κΔt²/3 of the sum of its groups' pulls (Jacobi), a gradient
-        // step on the shape-matching energy U = (κ/3) Σ_c U_c (§3.3).
+      for (int it = 0; it < p.iterations; ++it) {
+        // Shape matching over each particle's neighbourhood {c-1, c, c+1} (Jacobi: averaged).
         // E_j = R(q_j) R(q̄_j)ᵀ = R(q_j q̄_j⁻¹); that quaternion also warm-starts group j's fit.
         for (std::size_t j = 0; j < count; ++j) {
           w.orientation_quats[j] = q[j] * w.q_rest_conjugate[j];
@@ -286,66 +222,32 @@ void RodSystem::simulate(std::size_t r, const FrameInput& input, const std::vect
             }
           }
           A += lo >= 2 ? Mat3(ellipsoid * orientations) : orientations;
-          // Rotational part of A: two warm-started steps of Müller et al. 2016 (see extract_rotation),
-          // from the guess q_c q̄_c⁻¹ whose matrix E_c is already at hand. The second step matters:
-          // a particle whose spin lags its group would otherwise pull with a force that is not
-          // the gradient of U, and such strands gained energy (§3.3).
+          // Rotational part of A: one warm-started step of Müller et al. 2016 (see extract_rotation),
+          // from the guess q_c q̄_c⁻¹ whose matrix E_c is already at hand.
           const Mat3& G = w.orientation_terms[c];
           const Vec3 torque = G.col(0).cross(A.col(0)) + G.col(1).cross(A.col(1)) + G.col(2).cross(A.col(2));
           const Real denom = std::abs(G.col(0).dot(A.col(0)) + G.col(1).dot(A.col(1)) + G.col(2).dot(A.col(2))) + 1e-12;
           const Vec3 omega = torque * (Real(0.5) / denom);
           Quat R = w.orientation_quats[c];
           Mat3 Rm = G;
-          const Real first_step = omega.squaredNorm();
-          if (first_step >= Real(0.25e-24)) {
+          if (omega.squaredNorm() >= Real(0.25e-24)) {
             R = unit(Quat(1, omega.x(), omega.y(), omega.z()) * R);
             Rm = rotation_matrix(R);
-          }
-          if (first_step >= Real(0.25e-24)) {
-            const Vec3 torque2 = Rm.col(0).cross(A.col(0)) + Rm.col(1).cross(A.col(1)) + Rm.col(2).cross(A.col(2));
-            const Real denom2 =
-                std::abs(Rm.col(0).dot(A.col(0)) + Rm.col(1).dot(A.col(1)) + Rm.col(2).dot(A.col(2))) + 1e-12;
-            const Vec3 omega2 = torque2 * (Real(0.5) / denom2);
-            if (omega2.squaredNorm() >= Real(0.25e-24)) {
-              R = unit(Quat(1, omega2.x(), omega2.y(), omega2.z()) * R);
-              Rm = rotation_matrix(R);
-            }
           }
           for (std::size_t i = 0; i < members; ++i) {
             const std::size_t j = lo + i;
             if (j < 2) continue;
             w.displacement[j] += Rm * rest[i] + centroid - x[j];
           }
-          w.group_rotations[c] = R;
+          w.new_q[c] = R * q_rest[c];
         }
-        for (std::size_t j = 2; j < count; ++j) x[j] += stiffness * w.displacement[j];
-        // Orientations: particle j is a member of the groups j-1, j, j+1 (those that exist), each
-        // pulling E_j toward its R: it turns toward their mean by a third of κΔt² per group.
+        for (std::size_t j = 2; j < count; ++j) x[j] += (stiffness * w.inverse_hits[j]) * w.displacement[j];
         for (std::size_t c = 1; c < count; ++c) {
-          Eigen::Matrix<Real, 4, 1> sum = w.group_rotations[c].coeffs();
-          int groups = 1;
-          if (c >= 2) {
-            const auto& other = w.group_rotations[c - 1].coeffs();
-            sum += other.dot(sum) < 0 ? Eigen::Matrix<Real, 4, 1>(-other) : Eigen::Matrix<Real, 4, 1>(other);
-            ++groups;
-          }
-          if (c + 1 < count) {
-            const auto& other = w.group_rotations[c + 1].coeffs();
-            sum += other.dot(sum) < 0 ? Eigen::Matrix<Real, 4, 1>(-other) : Eigen::Matrix<Real, 4, 1>(other);
-            ++groups;
-          }
-          Quat mean;
-          mean.coeffs() = sum;
-          const Quat target = mean * q_rest[c];
-          const Real fraction = stiffness * Real(groups);
+          const Quat& target = w.new_q[c];
           // Blend towards the (sign-aligned) target; the normalisation absorbs |target| != 1.
-          const Real sign = target.dot(q[c]) < 0 ? -fraction : fraction;
-          q[c] = unit(Quat((1 - fraction) * q[c].coeffs() * target.norm() + sign * target.coeffs()));
+          const Real sign = target.dot(q[c]) < 0 ? -stiffness : stiffness;
+          q[c] = unit(Quat((1 - stiffness) * q[c].coeffs() + sign * target.coeffs()));
         }
-      }
-      for (std::size_t j = 2; j < count; ++j) x[j] += (dt * dt) * gravity;
-      // `iterations` passes of the length and collider constraints (Gauss-Seidel).
-      for (int it = 0; it < p.iterations; ++it) {
         // Inextensibility: PBD distance constraints, root (kinematic) to tip.
         project_distance(x[1], x[2], 0, 1, w.lengths[0]);
         for (std::size_t k = 1; k < n; ++k) project_distance(x[k + 1], x[k + 2], 1, 1, w.lengths[k]);
@@ -382,12 +284,6 @@ void RodSystem::simulate(std::size_t r, const FrameInput& input, const std::vect
       for (std::size_t j = 2; j < count; ++j) s.v[j] = (x[j] - s.prev_x[j]) * inverse_dt;
       for (std::size_t j = 1; j < count; ++j) s.omega[j] = angular_velocity(s.prev_q[j], q[j], dt);
     }
-  }
-  if (steps > 0) {
-    // Internal friction once per frame, as a decay over the frame's time (§3.3).
-    const Vec3 anchor_spin = angular_velocity(anchor_start_rotation, anchor_end_rotation, frame_time);
-    internal_friction(x, s.v.data(), s.omega.data(), count, anchor_velocity, anchor_spin, ellipsoid,
-                      (1 - std::exp(-kInternalFriction * frame_time)) / 3, w.dv, w.dw);
   }
   s.anchor_position = anchor_end;
   s.anchor_rotation = anchor_end_rotation;
