@@ -164,7 +164,7 @@ void bind_rod(py::module_& m) {
       .def_property_readonly("rod_count", &RodSystem::rod_count)
       .def_property_readonly("bone_count", &RodSystem::bone_count)
       .def("add_rod", &add_rod, py::arg("parent_bone"), py::arg("reference_bone"), py::arg("bones"),
-           py::arg("offsets"), py::arg("rest_rotations"), py::arg("stiffness") = 0.5, py::arg("damping") = 1.0,
+           py::arg("offsets"), py::arg("rest_rotations"), py::arg("stiffness") = 0.5, py::arg("damping") = 2.0,
            py::arg("gravity") = 1.0, py::arg("substeps") = 4, py::arg("iterations") = 1, py::arg("radius") = 0.01,
            py::arg("wind"), py::arg("key_conditions"), py::arg("key_directions"), py::arg("key_rotations"),
            py::arg("key_speeds"), py::arg("key_influences"), py::arg("key_shapes"),
@@ -255,6 +255,20 @@ void bind_rod(py::module_& m) {
              if (rod >= self.rod_count()) throw py::index_error("rod index out of range");
              return points_array(self.joint_velocities(rod));
            }, py::arg("rod"))
+      .def("energy", [](const RodSystem& self, std::size_t rod, const py::handle& gravity) {
+             const Vec3 g = vec3(gravity, "gravity");
+             const ExclusiveUse use = exclusive(self);
+             if (rod >= self.rod_count()) throw py::index_error("rod index out of range");
+             const RodEnergy e = self.energy(rod, g);
+             py::dict out;
+             out["kinetic"] = e.kinetic;
+             out["gravitational"] = e.gravitational;
+             out["shape_matching"] = e.shape_matching;
+             out["total"] = e.total();
+             return out;
+           }, py::arg("rod"), py::arg("gravity"),
+           "The rod's energy per unit particle mass (J/kg) under gravity (3,) in armature space: kinetic,\n"
+           "gravitational, shape_matching and their total (docs/algorithms.md §3.3).")
       .def("weights", [](const RodSystem& self, std::size_t rod) {
              const ExclusiveUse use = exclusive(self);
              if (rod >= self.rod_count()) throw py::index_error("rod index out of range");

@@ -513,6 +513,12 @@ TARGETS = [
     ),
     Target("RodSystem.weights", lambda: {"rod": 0}, _rod_method("weights"), examples=10),
     Target(
+        "RodSystem.energy",
+        lambda: {"rod": 0, "gravity": np.array([0.0, 0.0, -9.81])},
+        _rod_method("energy"),
+        examples=20,
+    ),
+    Target(
         "RodSystem.reference_speed",
         lambda: {"rod": 0},
         _rod_method("reference_speed"),

@@ -3,6 +3,7 @@
 // the particle layout: ghost, root, joints, tip).
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 
 #include "kodawari/rod/rod_system.hpp"
@@ -21,14 +22,28 @@ constexpr Real kGustAmount = 0.6;
 constexpr Real kSubstepUnit = 24.0;
 constexpr long kMaxSubstepsPerFrame = 4096;
 // A substep is split when a joint would move more than this many (shortest) bone lengths
-// relative to the root in it, into at most kMaxSplit parts (rod_simulate.cpp). Measured:
-// 1.5 keeps strands of 16-64 bones without damping from gaining energy; 2 does not.
+// relative to the root in it (rod_simulate.cpp). Measured: 1.5 keeps strands of 16-64 bones
+// without damping from gaining energy; 2 does not.
 constexpr Real kMaxTravel = 1.5;
-constexpr int kMaxSplit = 16;
-// ... or when gravity would drop a joint by more than this many bone lengths in one.
-// Measured: 0.25 let 64-bone strands gain energy at 1 substep; 0.1 splits the default
-// substeps of 0.6 m strands of 64 bones and slows their settling past 10 s.
+// ... or when the chain's tension would make its string mode outrun the substep
+// (docs/algorithms.md §3.3): n g Δt² / l, n the joints the root bone carries, must stay
+// below this. Position projection with v = Δx/Δt resolves the mode ω² ≈ 4 n g / l only
+// while ω Δt < 2, i.e. n g Δt² / l < 1. Measured: 1 keeps hanging 32-64-bone strands with
+// damping 20 from gaining energy and splits no strand of 16 bones of 2 cm or longer at the
+// default 4 substeps; with no such split they gain up to 0.06 J a frame.
+constexpr Real kMaxTension = 1.0;
+// ... or when gravity alone would drop a joint by more than this many bone lengths in one.
 constexpr Real kMaxDrop = 0.15;
+constexpr int kMaxSplit = 32;
+// Stiffness per unit mass (1/s²) that the shape-matching fraction of a substep stands for,
+// read as one implicit Euler step of a spring (s = κΔt² / (1 + κΔt²)): the coefficient of the
+// shape-matching energy (rod_energy.cpp). The fraction compounds over the iterations; a
+// fraction of 1 is a hard constraint, read as 0.99.
+inline Real shape_stiffness(const RodParams& p) {
+  const Real dt = 1 / (kSubstepUnit * Real(p.substeps));
+  const Real left = std::max(std::pow(Real(1) - p.stiffness, Real(p.iterations)), Real(0.01));
+  return (1 - left) / (left * dt * dt);
+}
 // Rods per work chunk (threads take chunks as they go): about 0.2 ms of work at 16 bones.
 constexpr std::size_t kRodsPerChunk = 16;
 

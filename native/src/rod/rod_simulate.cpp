@@ -144,11 +144,12 @@ void RodSystem::simulate(std::size_t r, const FrameInput& input, const std::vect
     const Real travel = (std::sqrt(fastest) + gravity.norm() * base_dt) * base_dt;
     // Gravity alone drops every joint by g dt² per substep while the root holds; the
     // projection lifts them all back through the root's bone, so that drop must stay a
-    // small part of a bone (kMaxDrop; g dt² is 1 mm at the default 96 Hz, 1.7 cm at one
-    // substep per frame).
+    // small part of a bone (kMaxDrop), and the tension it builds along the chain, about
+    // n g dt² at the root, must stay below half a bone (kMaxTension; §3.3).
     const Real drop = gravity.norm() * base_dt * base_dt;
-    const Real split_needed = std::max(std::ceil(travel / (kMaxTravel * min_length)),
-                                       std::ceil(std::sqrt(drop / (kMaxDrop * min_length))));
+    const Real split_needed =
+        std::max({std::ceil(travel / (kMaxTravel * min_length)), std::ceil(std::sqrt(drop / (kMaxDrop * min_length))),
+                  std::ceil(std::sqrt(Real(n) * drop / (kMaxTension * min_length)))});
     const int split = static_cast<int>(std::clamp(split_needed, Real(1), Real(kMaxSplit)));
     const Real dt = base_dt / Real(split);
     const Real inverse_dt = 1 / dt;

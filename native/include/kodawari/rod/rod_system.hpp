@@ -40,7 +40,7 @@ struct RodKey {
 
 struct RodParams {
   Real stiffness = 0.5;     // shape-matching fraction per iteration, (0, 1]
-  Real damping = 1.0;       // velocity decay rate, 1/s
+  Real damping = 2.0;       // velocity decay rate, 1/s (docs/algorithms.md §3.3: why 2)
   Real gravity = 1.0;       // multiple of the scene's gravity
   int substeps = 4;         // substeps per 1/24 s: the substep rate is 24 * substeps Hz
   int iterations = 1;       // constraint iterations per substep
@@ -92,6 +92,15 @@ struct RodState {
   bool initialised = false;
 };
 
+// A rod's mechanical energy per unit particle mass (docs/algorithms.md §3.3): what the solver
+// must never add to without input motion.
+struct RodEnergy {
+  Real kinetic = 0;         // ½ Σ |v_j|² + ½ Σ I |ω_j|² (I = 2e, the particles' inertia)
+  Real gravitational = 0;   // -Σ g · x_j
+  Real shape_matching = 0;  // (κ / 3) Σ_c min_R [½ Σ w_i |R r̄_i + c - x_i|² + ½ e Σ w_i |R - E_i|²]
+  Real total() const { return kinetic + gravitational + shape_matching; }
+};
+
 class RodSystem {
  public:
   explicit RodSystem(std::size_t bone_count, unsigned threads = 0);
@@ -113,6 +122,8 @@ class RodSystem {
   Vec3List joint_positions(std::size_t rod) const;
   Vec3List joint_velocities(std::size_t rod) const;
   const std::vector<Real>& weights(std::size_t rod) const { return weights_[rod]; }
+  // The rod's energy now, under `gravity` (armature space, before the rod's gravity factor).
+  RodEnergy energy(std::size_t rod, const Vec3& gravity) const;
   Real reference_speed(std::size_t rod) const { return states_[rod].speed; }
   // The rest shape blended this frame (per-bone rotations).
   const QuatList& rest_shape(std::size_t rod) const { return states_[rod].rest_local; }
