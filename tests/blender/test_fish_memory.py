@@ -59,3 +59,25 @@ def test_the_frame_written_in_place_is_the_deformation_and_nothing_else_changes(
     # The user's mesh and Basis are untouched by the in-place writes.
     assert np.array_equal(rest(obj), mesh_before)
     assert np.array_equal(_basis(obj), basis_before)
+
+
+def test_add_fish_swim_binds_the_mesh_once(empty_scene, monkeypatch):
+    # Binding a 4 M-vertex mesh takes seconds and a binding's worth of memory: Add Fish Swim
+    # keeps its trial bind instead of binding again for the first frame.
+    from kodawari.fish import rig as rig_module
+
+    binds = []
+    bind = rig_module.SwimRig.__init__
+
+    def counted(self, *args, **kwargs):
+        binds.append(args[0].name)
+        bind(self, *args, **kwargs)
+
+    monkeypatch.setattr(rig_module.SwimRig, "__init__", counted)
+    set_fps(24)
+    obj = make_fish("tuna")
+    add_swim(obj, head_axis="POS_X", preset="CARANGIFORM", frequency=2.0)
+    for frame in (2, 3):
+        bpy.context.scene.frame_set(frame)
+    assert binds == [obj.name]
+    assert np.abs(evaluated(obj) - live(obj)).max() < 1e-6

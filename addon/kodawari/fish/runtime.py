@@ -51,6 +51,19 @@ def get_rig(obj, build=True, known_weights=None):
     return rig
 
 
+def adopt(obj, rig):
+    """Keep a rig bound for obj just before its shape keys were added (Add Fish Swim's trial
+    bind) instead of binding the mesh again: same rest shape and settings, so only where the
+    rest positions now live (the Basis key) is refreshed. A rig bound with other settings
+    is dropped and get_rig binds again."""
+    if rig.signature != rig_module.binding_signature(obj, obj.kodawari_swim):
+        return
+    rig.fingerprint = rig_module.rest_fingerprint(obj)
+    rig.mesh_pointer = obj.data.as_pointer()
+    rig.owner = obj
+    _rigs[_key(obj)] = rig
+
+
 def body_rig(obj):
     """A rig whose rest shape and body axis are current (its fins may be out of date):
     what checking a new fin needs, without rebinding every fin."""
