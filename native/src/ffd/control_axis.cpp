@@ -7,13 +7,13 @@
 
 #include "kodawari/ffd/closest_point.hpp"
 #include "kodawari/parallel.hpp"
+#include "kodawari/worker_pool.hpp"
 
 namespace kodawari::ffd {
 
 namespace {
-// Vertices per chunk a deform thread takes at a time: below this, spawning threads costs
-// more than it saves; taking chunks (not fixed halves) keeps a descheduled thread on a
-// busy machine from holding up the frame.
+// Vertices per chunk a deform thread takes at a time (worker_pool.hpp: threads kept for the
+// process, the caller never waiting for one that has not started).
 constexpr std::size_t kDeformGrain = 32768;
 constexpr std::size_t kMinBindVerticesPerThread = 512;
 
@@ -187,7 +187,7 @@ void AxisBinding::deform(const Vec3List& control_points, const std::vector<Real>
 
   const AxisCoordinate* coords = coordinates_.data();
   const TableSegment* segments = table.data();
-  parallel_for_dynamic(coordinates_.size(), threads, kDeformGrain, [&](std::size_t begin, std::size_t end) {
+  parallel_chunks(coordinates_.size(), threads, kDeformGrain, [&](std::size_t begin, std::size_t end) {
     for (std::size_t i = begin; i < end; ++i) deform_vertex(segments[coords[i].segment], coords[i], out + 3 * i);
   });
 }
