@@ -21,7 +21,6 @@ carries the rest normal instead), close enough to measure time and memory.
 import gc
 import os
 import sys
-import time
 
 import bpy
 import numpy as np
@@ -38,7 +37,7 @@ SIDES = ("kodawari", "gn_route", "geometry_nodes", "floor")
 
 
 def _enabled(sockets, name=None):
-    return [s for s in sockets if s.enabled and (name is None or s.name == name)][0]
+    return next(s for s in sockets if s.enabled and (name is None or s.name == name))
 
 
 def _named(nodes, name, data_type):
@@ -183,7 +182,7 @@ def main():
     print(
         f"=== fish, the Geometry Nodes route prototype ({benchlib.blender_label()}, load {benchlib.load()})"
     )
-    for count, (ring, rings, per_round) in benchlib.sizes(bf.SIZES).items():
+    for _count, (ring, rings, per_round) in benchlib.sizes(bf.SIZES).items():
         bpy.ops.wm.read_homefile(use_empty=True)
         main_scene = bpy.context.scene
         main_scene.render.fps = 24
