@@ -71,16 +71,18 @@ def pose_bone_matrices(pose_bones, out=None):
     return out.transpose(0, 2, 1)
 
 
-# Shape key data without RNA: Blender has no raw-array path for ShapeKeyPoint, so
-# foreach_set costs ~90 ns per vertex (a 1 M-vertex key: ~90 ms). A KeyBlock keeps
-# its positions in one float array; DNA_key_types.h lays out KeyBlock as
+# Shape key data without RNA. A KeyBlock keeps its positions in one float array;
+# DNA_key_types.h lays out KeyBlock as
 #   next, prev (2 pointers) | pos, curval (float) | type, pad, relative, flag (short) |
 #   totelem (int, offset 32) | uid (int) | data (pointer, offset 40)
-# in Blender 2.8 through 5.0. The layout is checked against RNA before every write
-# (element count, first and last positions); any mismatch falls back to foreach_set.
+# in Blender 2.8 through 5.0 (checked in 3.4.1, 4.5 and 5.0.1). The layout is checked against
+# RNA before every use (element count, first and last positions); any mismatch means None and
+# the callers go through foreach_set. Before 4.1 RNA has no raw path for ShapeKeyPoint
+# (foreach_set ~90 ns per vertex: a 1 M-vertex key ~90 ms); from 4.1 ShapeKey.points has one,
+# but writing in place still saves the caller's own (N, 3) buffer and one copy per frame.
 _KEYBLOCK_TOTELEM_OFFSET = 32
 _KEYBLOCK_DATA_OFFSET = 40
-_KEYBLOCK_LAYOUT_VERSIONS = ((2, 80, 0), (4, 1, 0))
+_KEYBLOCK_LAYOUT_VERSIONS = ((2, 80, 0), (5, 1, 0))
 
 
 def _shape_key_view(key_block, count):
@@ -92,15 +94,30 @@ def _shape_key_view(key_block, count):
     data = ctypes.c_void_p.from_address(address + _KEYBLOCK_DATA_OFFSET).value
     if not data:
         return None
-    view = np.ctypeslib.as_array((ctypes.c_float * (3 * count)).from_address(data)).reshape(
-        count, 3
-    )
+    # frombuffer: numpy's own float32 dtype (the native module checks dtype identity)
+    view = np.frombuffer((ctypes.c_float * (3 * count)).from_address(data), np.float32)
+    view = view.reshape(count, 3)
     first, last = key_block.data[0].co, key_block.data[count - 1].co
     if tuple(view[0]) != tuple(np.float32(c) for c in first) or tuple(view[-1]) != tuple(
         np.float32(c) for c in last
     ):
         return None
     return view
+
+
+def shape_key_view(key_block):
+    """A writable float32 (N, 3) view of the shape key's positions in Blender's own memory, or
+    None where the layout above cannot be confirmed. Valid until the key changes (Edit Mode,
+    a removed key): take it again for every write, never keep it. After writing, tag_shape_key."""
+    if not _KEYBLOCK_LAYOUT_VERSIONS[0] <= bpy.app.version < _KEYBLOCK_LAYOUT_VERSIONS[1]:
+        return None
+    count = len(key_block.data)
+    return _shape_key_view(key_block, count) if count else None
+
+
+def tag_shape_key(key_block):
+    """Tell Blender a shape key's positions changed (see write_shape_key_positions: the Key only)."""
+    key_block.id_data.update_tag()
 
 
 def write_shape_key_positions(key_block, positions):
@@ -115,7 +132,7 @@ def write_shape_key_positions(key_block, positions):
     positions = np.ascontiguousarray(positions, dtype=np.float32)
     # Only where RNA has no raw path (before 4.1) and the layout above is known to hold;
     # 4.1+ writes through ShapeKey.points at the same speed without touching memory.
-    raw_ok = _KEYBLOCK_LAYOUT_VERSIONS[0] <= bpy.app.version < _KEYBLOCK_LAYOUT_VERSIONS[1]
+    raw_ok = _KEYBLOCK_LAYOUT_VERSIONS[0] <= bpy.app.version < (4, 1, 0)
     view = (
         _shape_key_view(key_block, count)
         if raw_ok and count and positions.shape == (count, 3)
@@ -125,5 +142,5 @@ def write_shape_key_positions(key_block, positions):
         _shape_key_points(key_block).foreach_set("co", positions.reshape(-1))
     else:
         np.copyto(view, positions)
-    key_block.id_data.update_tag()
+    tag_shape_key(key_block)
     return view is not None

@@ -126,6 +126,18 @@ TEST(FfdControlAxis, ResultsAreBitIdenticalForAnyThreadCountAndRun) {
   }
 }
 
+TEST(FfdControlAxis, ACurveBeyondFloatRangeThrowsBeforeWritingAnyVertex) {
+  // `out` may be a shape key the user sees: a refused frame must leave it as it was.
+  const Vec3List axis = fixtures::straight_axis();
+  const std::vector<float> mesh = fixtures::box_mesh(100);
+  const AxisBinding binding(axis, mesh.data(), 100, {}, std::nullopt);
+  Vec3List huge;
+  for (const Vec3& p : axis) huge.push_back(p * 1e39);  // finite in double, not in float
+  std::vector<float> out(300, 7.0f);
+  EXPECT_THROW(binding.deform(huge, {}, std::nullopt, out.data()), std::invalid_argument);
+  for (float value : out) ASSERT_EQ(value, 7.0f);
+}
+
 TEST(FfdControlAxis, BadInputThrowsNamingTheArgument) {
   const Vec3List axis = fixtures::straight_axis();
   const std::vector<float> mesh = fixtures::box_mesh(10);

@@ -82,7 +82,7 @@ class KODAWARI_OT_swim_add(bpy.types.Operator):
             head_axis=head_axis, control_points=obj.kodawari_swim.control_points, fins=[]
         )
         try:
-            rig_module.SwimRig(obj, trial)
+            trial_rig = rig_module.SwimRig(obj, trial)
         except ValueError as exc:
             self.report(
                 {"ERROR"}, tip_("Cannot bind '{}' to a swim axis: {}").format(obj.name, exc)
@@ -108,6 +108,7 @@ class KODAWARI_OT_swim_add(bpy.types.Operator):
         # The handler writes the shape key on frame changes; renders must wait for it.
         context.scene.render.use_lock_interface = True
         runtime.forget(obj)
+        runtime.adopt(obj, trial_rig)  # the trial bind is the binding: no second one
         runtime.evaluate(obj, context.scene)
         self.report(
             {"INFO"},

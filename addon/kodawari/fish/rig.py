@@ -63,14 +63,18 @@ class SwimRig:
         self.signature = binding_signature(obj, settings)
         self.fingerprint = rest_fingerprint(obj)
         self.mesh_pointer = obj.data.as_pointer()
-        self.rest = rest_positions(obj)
-        self.count = len(self.rest)
+        # The rest shape and the deformed positions are not kept: the binding holds what a
+        # frame needs, and a frame deforms straight into the shape key (runtime.evaluate).
+        # Two (N, 3) copies less per fish (memory, issue 13); `rest` re-reads on request.
+        self.owner = obj  # refreshed by runtime.get_rig/body_rig before every use
+        self.positions = None  # allocated only for a caller without an `out`
+        rest = rest_positions(obj)
+        self.count = len(rest)
         self.head, self.up, self.side = midline.body_frame(settings.head_axis)
         self.axis_rest, self.body_length = midline.midline_points(
-            self.rest, settings.head_axis, settings.control_points
+            rest, settings.head_axis, settings.control_points
         )
-        self.binding = kn.ffd_bind(self.axis_rest, self.rest, up=self.up)
-        self.positions = np.empty_like(self.rest)
+        self.binding = kn.ffd_bind(self.axis_rest, rest, up=self.up)
         self.axis = self.axis_rest.copy()
         self.parts = []
         known_weights = known_weights or {}
@@ -88,16 +92,16 @@ class SwimRig:
         if in_fin.any() and not in_fin.all():
             edges = np.empty((len(obj.data.edges), 2), dtype=np.int32)
             obj.data.edges.foreach_get("vertices", edges.reshape(-1))
-            reach = fin_setup.fin_reach(self.rest, edges, in_fin, self.body_length, kn)
-        self.parts = self._build_parts(settings, weights, reach)
+            reach = fin_setup.fin_reach(rest, edges, in_fin, self.body_length, kn)
+        self.parts = self._build_parts(settings, weights, rest, reach)
         # Swinging fins (FLAP, UP_DOWN) fade in over a reach squashed along their motion
         # (docs/algorithms.md §2.4): bound again with it, same roots and tips.
         squash = fin_setup.swing_squash(self.parts, settings.fins, self.count)
         if reach is not None and squash is not None:
             swing_reach = fin_setup.fin_reach(
-                self.rest, edges, in_fin, self.body_length, kn, squash
+                rest, edges, in_fin, self.body_length, kn, squash
             )
-            self.parts = self._build_parts(settings, weights, reach, swing_reach)
+            self.parts = self._build_parts(settings, weights, rest, reach, swing_reach)
         # Four probe points per fin part (root and one step along its tangent, side, up):
         # deformed with the body they give the body's rotation at the root.
         arm = PROBE_SCALE * self.body_length
@@ -115,7 +119,7 @@ class SwimRig:
             self.probe_binding = kn.ffd_bind(self.axis_rest, self.probes_rest, up=self.up)
             self.probes_out = np.empty_like(self.probes_rest)
 
-    def _build_parts(self, settings, weights, reach, swing_reach=None):
+    def _build_parts(self, settings, weights, rest, reach, swing_reach=None):
         parts = []
         for index, fin in enumerate(settings.fins):
             if fin.enabled:
@@ -124,7 +128,7 @@ class SwimRig:
                         index,
                         fin,
                         weights[fin.vertex_group],
-                        self.rest,
+                        rest,
                         self.axis_rest,
                         self.up,
                         self.kn,
@@ -133,6 +137,11 @@ class SwimRig:
                     )
                 )
         return parts
+
+    @property
+    def rest(self):
+        """float32 (N, 3) rest positions, read from the mesh (set-up work only, e.g. a fin search)."""
+        return rest_positions(self.owner)
 
     def bend_direction(self, settings):
         return self.up if settings.bend == "DORSOVENTRAL" else self.side
@@ -152,13 +161,19 @@ class SwimRig:
             preserve_length=settings.preserve_length,
         )
 
-    def evaluate(self, settings, phase, rest_axis=None):
-        """Deformed positions float32 (N, 3) for the phase (radians, accumulated); `rest_axis`
-        replaces the straight rest axis (a spine bent along a path) before the wave."""
+    def evaluate(self, settings, phase, rest_axis=None, out=None):
+        """Deformed positions float32 (N, 3) for the phase (radians, accumulated), written into
+        `out` (e.g. the shape key's memory) or the rig's own buffer; `rest_axis` replaces the
+        straight rest axis (a spine bent along a path) before the wave."""
+        if out is None:
+            if self.positions is None:
+                self.positions = np.empty((self.count, 3), dtype=np.float32)
+            out = self.positions
+        positions = out
         self.axis = self.body_axis(settings, phase, rest_axis)
-        self.binding.deform(self.axis, self.positions)
+        self.binding.deform(self.axis, positions)
         if not self.parts:
-            return self.positions
+            return positions
         self.probe_binding.deform(self.axis, self.probes_out)
         for k, part in enumerate(self.parts):
             fin = settings.fins[part.fin_index]
@@ -184,5 +199,5 @@ class SwimRig:
                 self.probes_out[4 * k : 4 * k + 4],
                 part.out,
             )
-            self.positions[part.indices] += part.out
-        return self.positions
+            positions[part.indices] += part.out
+        return positions

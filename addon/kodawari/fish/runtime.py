@@ -46,7 +46,22 @@ def get_rig(obj, build=True, known_weights=None):
     if rig is None and build:
         rig = rig_module.SwimRig(obj, settings, known_weights)
         _rigs[_key(obj)] = rig
+    if rig is not None:
+        rig.owner = obj
     return rig
+
+
+def adopt(obj, rig):
+    """Keep a rig bound for obj just before its shape keys were added (Add Fish Swim's trial
+    bind) instead of binding the mesh again: same rest shape and settings, so only where the
+    rest positions now live (the Basis key) is refreshed. A rig bound with other settings
+    is dropped and get_rig binds again."""
+    if rig.signature != rig_module.binding_signature(obj, obj.kodawari_swim):
+        return
+    rig.fingerprint = rig_module.rest_fingerprint(obj)
+    rig.mesh_pointer = obj.data.as_pointer()
+    rig.owner = obj
+    _rigs[_key(obj)] = rig
 
 
 def body_rig(obj):
@@ -58,7 +73,10 @@ def body_rig(obj):
         or rig.mesh_pointer != obj.data.as_pointer()
     ):
         rig = None
-    return rig if rig is not None else get_rig(obj)
+    if rig is None:
+        return get_rig(obj)
+    rig.owner = obj
+    return rig
 
 
 @contextlib.contextmanager
@@ -103,7 +121,9 @@ def apply_travel(obj, rig, distance):
 
 
 def evaluate(obj, scene, frame=None):
-    """Deform one object for a frame (the scene's current frame by default); returns positions."""
+    """Deform one object for a frame (the scene's current frame by default) into its swim shape
+    key; returns the positions: a view of the key's own memory (copy it to keep it) or the
+    rig's buffer."""
     settings = obj.kodawari_swim
     rig = get_rig(obj)
     if frame is None:
@@ -122,9 +142,14 @@ def evaluate(obj, scene, frame=None):
         )
     elif settings.speed_mode != "NONE":
         apply_travel(obj, rig, distance)
-    positions = rig.evaluate(settings, phase, rest_axis)
     block = swim_key_block(obj)
-    if block is not None:
+    # Deform straight into the key where its memory can be reached: no (N, 3) buffer of our
+    # own and no copy per frame; else into the rig's buffer, then foreach_set.
+    view = bulk.shape_key_view(block) if block is not None else None
+    positions = rig.evaluate(settings, phase, rest_axis, out=view)
+    if view is not None:
+        bulk.tag_shape_key(block)
+    elif block is not None:
         bulk.write_shape_key_positions(block, positions)
     return positions
 

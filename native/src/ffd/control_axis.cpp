@@ -7,12 +7,14 @@
 
 #include "kodawari/ffd/closest_point.hpp"
 #include "kodawari/parallel.hpp"
+#include "kodawari/worker_pool.hpp"
 
 namespace kodawari::ffd {
 
 namespace {
-// Below this many vertices per thread, spawning threads costs more than it saves.
-constexpr std::size_t kMinVerticesPerThread = 16384;
+// Vertices per chunk a deform thread takes at a time (worker_pool.hpp: threads kept for the
+// process, the caller never waiting for one that has not started).
+constexpr std::size_t kDeformGrain = 32768;
 constexpr std::size_t kMinBindVerticesPerThread = 512;
 
 // The deformer's curve is the table's interpolated one, which differs from the
@@ -46,6 +48,25 @@ void refine_on_table(const FrameTable& table, const Vec3& p, std::uint32_t& segm
   }
   segment = static_cast<std::uint32_t>(s);
   fraction = static_cast<float>(std::clamp(f, Real(0), Real(1)));
+}
+
+// Throws unless every position deform_vertex can make from this table and coordinates no
+// larger than `reach` is finite: each lane is at most 2 A (1 + 3 reach), A the largest
+// table entry, and that stays well inside float's range.
+void require_finite_positions(const FrameTable& table, float reach) {
+  double largest = 0;
+  bool finite = true;
+  for (const TableSegment& s : table) {
+    for (const Vec4f* v : {&s.origin, &s.d_origin, &s.e1, &s.d_e1, &s.e2, &s.d_e2, &s.e3, &s.d_e3}) {
+      finite = finite && v->allFinite();
+      largest = std::max(largest, double(v->cwiseAbs().maxCoeff()));
+    }
+  }
+  if (!finite || !(2.0 * largest * (1.0 + 3.0 * double(reach)) < 1e36)) {
+    throw std::invalid_argument(
+        "control_points: the curve is too close to degenerate to deform the mesh (non-finite positions); "
+        "spread the points apart");
+  }
 }
 
 }  // namespace
@@ -134,6 +155,9 @@ AxisBinding::AxisBinding(const Vec3List& control_points, const float* vertices, 
       }
     }
   });
+  for (const AxisCoordinate& c : coordinates_) {
+    reach_ = std::max({reach_, std::abs(c.u), std::abs(c.v), std::abs(c.w)});
+  }
 }
 
 float AxisBinding::parameter(std::size_t i) const {
@@ -159,10 +183,11 @@ void AxisBinding::deform(const Vec3List& control_points, const std::vector<Real>
   rotation_minimising_frames(sampled, normal, frames);
   FrameTable table;
   fill_frame_table(frames, table);
+  require_finite_positions(table, reach_);
 
   const AxisCoordinate* coords = coordinates_.data();
   const TableSegment* segments = table.data();
-  parallel_for(coordinates_.size(), threads, kMinVerticesPerThread, [&](std::size_t begin, std::size_t end) {
+  parallel_chunks(coordinates_.size(), threads, kDeformGrain, [&](std::size_t begin, std::size_t end) {
     for (std::size_t i = begin; i < end; ++i) deform_vertex(segments[coords[i].segment], coords[i], out + 3 * i);
   });
 }

@@ -38,6 +38,9 @@ class AxisBinding {
   // Writes count() deformed xyz triples to `out`. Allocates only the fixed-size
   // frame table; every vertex is computed by one thread with the same
   // arithmetic, so the result does not depend on `threads` (0 = all cores).
+  // Every written position is finite: a curve whose frames would not give finite
+  // positions throws std::invalid_argument before `out` is touched (so `out` may be
+  // memory the user sees, e.g. a shape key, without a half-written frame).
   void deform(const Vec3List& control_points, const std::vector<Real>& twist, const std::optional<Vec3>& up,
               float* out, unsigned threads = 0) const;
 
@@ -47,6 +50,7 @@ class AxisBinding {
   Vec3 rest_tangent_ = Vec3::UnitX();
   Vec3 rest_normal_ = Vec3::UnitY();
   std::vector<AxisCoordinate> coordinates_;
+  float reach_ = 0;  // the largest |u|, |v|, |w| bound: with the frame table it bounds |P'|
 };
 
 }  // namespace kodawari::ffd
