@@ -71,6 +71,18 @@ def pose_bone_matrices(pose_bones, out=None):
     return out.transpose(0, 2, 1)
 
 
+def pose_rotations(pose_bones, out):
+    """Every pose bone's rotation_quaternion into float32 (B, 4) `out`."""
+    pose_bones.foreach_get("rotation_quaternion", out.reshape(-1))
+    return out
+
+
+def set_pose_rotations(pose_bones, rotations):
+    """Writes float32 (B, 4) into every pose bone's rotation_quaternion. No RNA update runs in
+    Blender 3.4 (4.x tags the object itself); the caller tags what must be evaluated again."""
+    pose_bones.foreach_set("rotation_quaternion", rotations.reshape(-1))
+
+
 # Shape key data without RNA: Blender has no raw-array path for ShapeKeyPoint, so
 # foreach_set costs ~90 ns per vertex (a 1 M-vertex key: ~90 ms). A KeyBlock keeps
 # its positions in one float array; DNA_key_types.h lays out KeyBlock as

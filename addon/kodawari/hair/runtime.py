@@ -15,7 +15,7 @@ pose it renders.
 
 import numpy as np
 
-from .. import native, problems
+from .. import bulk, native, problems
 from . import chains
 
 # The solver state of the last evaluated frame is saved into the .blend (save_pre)
@@ -68,9 +68,11 @@ SPARSE_READ_RATIO = 256
 
 def _tag(obj):
     """foreach_set bypasses RNA updates: tag the armature so its pose is re-evaluated.
-    The object tag suffices (the pose is evaluated after the object's transform) and costs
-    less than the data tag on large rigs: 16k bones, whole frame ~108 against ~124 ms in
-    Blender 3.4. test_the_blender_pose_follows_the_solver... fails without a working tag."""
+    Blender copies the whole armature object again (copy-on-write: every component of an
+    object asks for it on a tag) and evaluates all of it, so a tag costs about twice a plain
+    evaluation (docs/algorithms.md §3.7). The object tag is the cheapest that works: 16k
+    bones in Blender 3.4, second evaluation 39 against 57-93 ms for the data, both, time or
+    untyped tags. test_the_blender_pose_follows_the_solver... fails without a working tag."""
     obj.update_tag(refresh={"OBJECT"})
 
 
@@ -153,6 +155,7 @@ class ArmatureRuntime:
         self.rod_bones = np.array(rod_bones, dtype=np.int64)
         self.matrices = np.zeros((self.bone_count, 16), np.float32)
         self.rotations = np.empty((self.bone_count, 4), np.float32)
+        self.held = np.empty((self.bone_count, 4), np.float32)  # rotations a pose holds now
         # The solver reads only the matrices of parents, reference bones and colliders, and
         # writes every rod bone's rotation: in a hair rig both other sets are small, so they
         # are read one by one there instead of in bulk over every bone.
@@ -202,10 +205,39 @@ class ArmatureRuntime:
         armature_matrix = np.array([tuple(row) for row in evaluated.matrix_world], np.float64)
         return armature_matrix, camera_position, gravity
 
-    def _write(self, obj):
+    def _holds(self, pose_bones):
+        """True when these pose bones hold exactly the rotations to write."""
+        bulk.pose_rotations(pose_bones, self.held)
+        return np.array_equal(self.held, self.rotations)
+
+    def _write(self, obj, depsgraph=None):
+        """Writes the rotations into the armature; Blender evaluates it again (a tag: a copy of
+        the whole object and a second evaluation, §3.7) only when the pose `depsgraph` has just
+        evaluated was not already made from them, e.g. a frame show_cached() wrote before the
+        evaluation or a chain at rest. Without a depsgraph the tag is unconditional."""
+        if not self._holds(obj.pose.bones):
+            bulk.set_pose_rotations(obj.pose.bones, self.rotations)
+            _tag(obj)
+            return
+        evaluated = _evaluated(obj, depsgraph)
+        if depsgraph is None or evaluated.pose is None or not self._holds(evaluated.pose.bones):
+            _tag(obj)
+
+    def show_cached(self, obj, scene, frame):
+        """Before Blender evaluates `frame` (frame_change_pre): a frame the cache holds needs no
+        evaluated input, so its rotations go into the armature now and Blender evaluates the
+        frame once, with them, instead of twice (§3.7). Returns whether the frame was cached."""
+        if frame <= scene.frame_start or self.system.rod_count == 0:
+            return False
         pose_bones = obj.pose.bones
-        pose_bones.foreach_set("rotation_quaternion", self.rotations.reshape(-1))
-        _tag(obj)
+        self._read_other_rotations(pose_bones)
+        if not self.system.recall_frame(frame, self.rotations, load_state=self.last_frame != frame):
+            return False
+        self.last_frame = frame
+        if not self._holds(pose_bones):
+            bulk.set_pose_rotations(pose_bones, self.rotations)
+            _tag(obj)  # before the evaluation: Blender copies and evaluates the armature once
+        return True
 
     @property
     def cached_frames(self):
@@ -225,7 +257,7 @@ class ArmatureRuntime:
             if self.system.recall_frame(frame, self.rotations, load_state=self.last_frame != frame):
                 self.last_frame = frame
                 self.status = "" if active_camera(scene, frame) is not None else NO_CAMERA
-                self._write(obj)
+                self._write(obj, depsgraph)
                 return
         # The frame before, from the solver's own state when it was the last one simulated (the
         # budget may already have dropped it from the cache), else the latest cached one.
@@ -263,7 +295,7 @@ class ArmatureRuntime:
             )
         self.system.store_frame(frame, self.rotations)
         self.last_frame = frame
-        self._write(obj)
+        self._write(obj, depsgraph)
 
     def weights(self, rod_index):
         slot = self.rod_slots.get(rod_index)
@@ -355,6 +387,20 @@ def evaluate_scene(scene, depsgraph=None):
                 problems.report(obj, "hair", ValueError(rt.error))
             else:
                 problems.clear(obj, "hair")
+
+
+def show_cached_frames(scene):
+    """frame_change_pre: writes the frames the caches hold before Blender evaluates them."""
+    if _replaying:
+        return
+    for obj in hair_armatures(scene):
+        rt = get(obj, build=False)
+        if rt is None:
+            continue
+        try:
+            rt.show_cached(obj, scene, scene.frame_current)
+        except Exception:  # noqa: BLE001 - frame_change_post evaluates this frame again and reports
+            continue
 
 
 def store_state(obj):
