@@ -156,6 +156,8 @@ class ArmatureRuntime:
         self.matrices = np.zeros((self.bone_count, 16), np.float32)
         self.rotations = np.empty((self.bone_count, 4), np.float32)
         self.held = np.empty((self.bone_count, 4), np.float32)  # rotations a pose holds now
+        # (depsgraph, frame, changed bones, their matrices) after _write_evaluated, until checked.
+        self.pending = None
         # The solver reads only the matrices of parents, reference bones and colliders, and
         # writes every rod bone's rotation: in a hair rig both other sets are small, so they
         # are read one by one there instead of in bulk over every bone.
@@ -216,11 +218,18 @@ class ArmatureRuntime:
         evaluated was not already made from them, e.g. a frame show_cached() wrote before the
         evaluation or a chain at rest. Without a depsgraph the tag is unconditional."""
         if not self._holds(obj.pose.bones):
+            self.pending = None
             bulk.set_pose_rotations(obj.pose.bones, self.rotations)
             _tag(obj)
             return
         evaluated = _evaluated(obj, depsgraph)
-        if depsgraph is None or evaluated.pose is None or not self._holds(evaluated.pose.bones):
+        held = (
+            depsgraph is not None
+            and evaluated.pose is not None
+            and self._holds(evaluated.pose.bones)
+        )
+        if not (held and self._was_evaluated(evaluated.pose.bones, depsgraph, self.last_frame)):
+            self.pending = None
             _tag(obj)
 
     def show_cached(self, obj, scene, frame):
@@ -235,9 +244,50 @@ class ArmatureRuntime:
             return False
         self.last_frame = frame
         if not self._holds(pose_bones):
+            # Blender 4.x tags the armature itself here (its copy is then made from these).
             bulk.set_pose_rotations(pose_bones, self.rotations)
-            _tag(obj)  # before the evaluation: Blender copies and evaluates the armature once
+        self._write_evaluated(obj, frame)
         return True
+
+    def _write_evaluated(self, obj, frame):
+        """Writes the rotations into the viewport's evaluated armature too: when the frame change
+        re-evaluates the pose (an animated parent), it does so with them and without copying the
+        whole object again. Whether it did is checked after the evaluation (_was_evaluated);
+        without an evaluated copy to write, the armature is tagged (copied, evaluated once)."""
+        import bpy
+
+        if self.pending is not None:  # an earlier write nobody evaluated: let Blender copy afresh
+            self.pending = None
+            _tag(obj)
+            return
+        view_layer = bpy.context.view_layer
+        depsgraph = view_layer.depsgraph if view_layer is not None else None
+        evaluated = _evaluated(obj, depsgraph)
+        if depsgraph is None or evaluated == obj or evaluated.pose is None:
+            _tag(obj)
+            return
+        pose_bones = evaluated.pose.bones
+        if self._holds(pose_bones):
+            return
+        changed = np.any(self.held != self.rotations, axis=1)
+        before = bulk.pose_matrices_flat(pose_bones)
+        bulk.set_pose_rotations(pose_bones, self.rotations)
+        self.pending = (depsgraph.as_pointer(), frame, changed, before)
+
+    def _was_evaluated(self, pose_bones, depsgraph, frame):
+        """After an evaluation that follows _write_evaluated: did Blender evaluate the pose with
+        the rotations written into its copy? Every bone whose rotation changed must have a new
+        matrix (a pose nothing animates is not evaluated again on a frame change). A write into
+        another depsgraph's copy (the viewport's, while a render evaluates its own) is never
+        confirmed: False, so the caller's tag has Blender copy that armature afresh."""
+        pending, self.pending = self.pending, None
+        if pending is None:
+            return True  # nothing was written into an evaluated copy
+        if pending[0] != depsgraph.as_pointer() or pending[1] != frame:
+            return False
+        _, _, changed, before = pending
+        after = bulk.pose_matrices_flat(pose_bones)
+        return bool(np.all(np.any(after[changed] != before[changed], axis=1)))
 
     @property
     def cached_frames(self):
