@@ -67,12 +67,13 @@ SPARSE_READ_RATIO = 256
 
 
 def _tag(obj):
-    """foreach_set bypasses RNA updates: tag the armature so its pose is re-evaluated.
+    """foreach_set bypasses RNA updates (in 3.4): tag the armature so its pose is re-evaluated.
     Blender copies the whole armature object again (copy-on-write: every component of an
-    object asks for it on a tag) and evaluates all of it, so a tag costs about twice a plain
-    evaluation (docs/algorithms.md §3.7). The object tag is the cheapest that works: 16k
-    bones in Blender 3.4, second evaluation 39 against 57-93 ms for the data, both, time or
-    untyped tags. test_the_blender_pose_follows_the_solver... fails without a working tag."""
+    object asks for it on a tag) and evaluates all of it: Blender's own price, measured as
+    bare_retag in tests/bench/bench_hair.py (docs/algorithms.md §3.7). The object tag is the
+    cheapest that works (16k bones, Blender 3.4: the data, time, untyped and armature-data tags
+    cost 1.15-2.4x its second evaluation). test_the_blender_pose_follows_the_solver... fails
+    without a working tag."""
     obj.update_tag(refresh={"OBJECT"})
 
 
