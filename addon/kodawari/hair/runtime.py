@@ -245,8 +245,13 @@ class ArmatureRuntime:
             return False
         self.last_frame = frame
         if not self._holds(pose_bones):
-            # Blender 4.x tags the armature itself here (its copy is then made from these).
             bulk.set_pose_rotations(pose_bones, self.rotations)
+            if bulk.POSE_WRITE_TAGS:
+                # Blender copies the armature from these in the coming evaluation anyway: a
+                # write into its current copy would be lost. The tag makes sure of the copy.
+                self.pending = None
+                _tag(obj)
+                return True
         self._write_evaluated(obj, frame)
         return True
 
