@@ -71,6 +71,31 @@ def pose_bone_matrices(pose_bones, out=None):
     return out.transpose(0, 2, 1)
 
 
+def pose_matrices_flat(pose_bones):
+    """Every pose bone's armature-space matrix as float32 (B, 16), foreach_get's layout."""
+    out = np.empty((len(pose_bones), 16), dtype=np.float32)
+    pose_bones.foreach_get("matrix", out.reshape(-1))
+    return out
+
+
+def pose_rotations(pose_bones, out):
+    """Every pose bone's rotation_quaternion into float32 (B, 4) `out`."""
+    pose_bones.foreach_get("rotation_quaternion", out.reshape(-1))
+    return out
+
+
+# Blender 4.x runs the RNA update after a foreach_set on pose bones: the armature object is
+# tagged and its evaluated copy made afresh at the next evaluation (measured in 4.5 and 5.0;
+# 3.4 tags nothing, and a write then reaches only the original until something tags it).
+POSE_WRITE_TAGS = bpy.app.version >= (4, 0, 0)
+
+
+def set_pose_rotations(pose_bones, rotations):
+    """Writes float32 (B, 4) into every pose bone's rotation_quaternion (see POSE_WRITE_TAGS);
+    the caller tags what must be evaluated again."""
+    pose_bones.foreach_set("rotation_quaternion", rotations.reshape(-1))
+
+
 # Shape key data without RNA. A KeyBlock keeps its positions in one float array;
 # DNA_key_types.h lays out KeyBlock as
 #   next, prev (2 pointers) | pos, curval (float) | type, pad, relative, flag (short) |

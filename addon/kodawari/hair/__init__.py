@@ -14,6 +14,7 @@ PROPERTIES = (
     ),
 )
 HANDLERS = (
+    ("frame_change_pre", handlers.on_frame_change_pre),
     ("frame_change_post", handlers.on_frame_change),
     ("load_post", handlers.on_load),
     ("save_pre", handlers.on_save),

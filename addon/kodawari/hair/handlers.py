@@ -13,6 +13,11 @@ def on_frame_change(scene, depsgraph=None):
 
 
 @persistent
+def on_frame_change_pre(scene, depsgraph=None):
+    runtime.show_cached_frames(scene)
+
+
+@persistent
 def on_load(filepath=None):
     runtime.clear()
     for obj in bpy.data.objects:

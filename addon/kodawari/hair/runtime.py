@@ -15,7 +15,7 @@ pose it renders.
 
 import numpy as np
 
-from .. import native, problems
+from .. import bulk, native, problems
 from . import chains
 
 # The solver state of the last evaluated frame is saved into the .blend (save_pre)
@@ -67,10 +67,13 @@ SPARSE_READ_RATIO = 256
 
 
 def _tag(obj):
-    """foreach_set bypasses RNA updates: tag the armature so its pose is re-evaluated.
-    The object tag suffices (the pose is evaluated after the object's transform) and costs
-    less than the data tag on large rigs: 16k bones, whole frame ~108 against ~124 ms in
-    Blender 3.4. test_the_blender_pose_follows_the_solver... fails without a working tag."""
+    """foreach_set bypasses RNA updates (in 3.4): tag the armature so its pose is re-evaluated.
+    Blender copies the whole armature object again (copy-on-write: every component of an
+    object asks for it on a tag) and evaluates all of it: Blender's own price, measured as
+    bare_retag in tests/bench/bench_hair.py (docs/algorithms.md §3.7). The object tag is the
+    cheapest that works (16k bones, Blender 3.4: the data, time, untyped and armature-data tags
+    cost 1.15-2.4x its second evaluation). test_the_blender_pose_follows_the_solver... fails
+    without a working tag."""
     obj.update_tag(refresh={"OBJECT"})
 
 
@@ -153,6 +156,9 @@ class ArmatureRuntime:
         self.rod_bones = np.array(rod_bones, dtype=np.int64)
         self.matrices = np.zeros((self.bone_count, 16), np.float32)
         self.rotations = np.empty((self.bone_count, 4), np.float32)
+        self.held = np.empty((self.bone_count, 4), np.float32)  # rotations a pose holds now
+        # (depsgraph, frame, changed bones, their matrices) after _write_evaluated, until checked.
+        self.pending = None
         # The solver reads only the matrices of parents, reference bones and colliders, and
         # writes every rod bone's rotation: in a hair rig both other sets are small, so they
         # are read one by one there instead of in bulk over every bone.
@@ -202,10 +208,92 @@ class ArmatureRuntime:
         armature_matrix = np.array([tuple(row) for row in evaluated.matrix_world], np.float64)
         return armature_matrix, camera_position, gravity
 
-    def _write(self, obj):
+    def _holds(self, pose_bones):
+        """True when these pose bones hold exactly the rotations to write."""
+        bulk.pose_rotations(pose_bones, self.held)
+        return np.array_equal(self.held, self.rotations)
+
+    def _write(self, obj, depsgraph=None):
+        """Writes the rotations into the armature; Blender evaluates it again (a tag: a copy of
+        the whole object and a second evaluation, §3.7) only when the pose `depsgraph` has just
+        evaluated was not already made from them, e.g. a frame show_cached() wrote before the
+        evaluation or a chain at rest. Without a depsgraph the tag is unconditional."""
+        if not self._holds(obj.pose.bones):
+            self.pending = None
+            bulk.set_pose_rotations(obj.pose.bones, self.rotations)
+            _tag(obj)
+            return
+        evaluated = _evaluated(obj, depsgraph)
+        held = (
+            depsgraph is not None
+            and evaluated.pose is not None
+            and self._holds(evaluated.pose.bones)
+        )
+        if not (held and self._was_evaluated(evaluated.pose.bones, depsgraph, self.last_frame)):
+            self.pending = None
+            _tag(obj)
+
+    def show_cached(self, obj, scene, frame):
+        """Before Blender evaluates `frame` (frame_change_pre): a frame the cache holds needs no
+        evaluated input, so its rotations go into the armature now and Blender evaluates the
+        frame once, with them, instead of twice (§3.7). Returns whether the frame was cached."""
+        if frame <= scene.frame_start or self.system.rod_count == 0:
+            return False
         pose_bones = obj.pose.bones
-        pose_bones.foreach_set("rotation_quaternion", self.rotations.reshape(-1))
-        _tag(obj)
+        self._read_other_rotations(pose_bones)
+        if not self.system.recall_frame(frame, self.rotations, load_state=self.last_frame != frame):
+            return False
+        self.last_frame = frame
+        if not self._holds(pose_bones):
+            bulk.set_pose_rotations(pose_bones, self.rotations)
+            if bulk.POSE_WRITE_TAGS:
+                # Blender copies the armature from these in the coming evaluation anyway: a
+                # write into its current copy would be lost. The tag makes sure of the copy.
+                self.pending = None
+                _tag(obj)
+                return True
+        self._write_evaluated(obj, frame)
+        return True
+
+    def _write_evaluated(self, obj, frame):
+        """Writes the rotations into the viewport's evaluated armature too: when the frame change
+        re-evaluates the pose (an animated parent), it does so with them and without copying the
+        whole object again. Whether it did is checked after the evaluation (_was_evaluated);
+        without an evaluated copy to write, the armature is tagged (copied, evaluated once)."""
+        import bpy
+
+        if self.pending is not None:  # an earlier write nobody evaluated: let Blender copy afresh
+            self.pending = None
+            _tag(obj)
+            return
+        view_layer = bpy.context.view_layer
+        depsgraph = view_layer.depsgraph if view_layer is not None else None
+        evaluated = _evaluated(obj, depsgraph)
+        if depsgraph is None or evaluated == obj or evaluated.pose is None:
+            _tag(obj)
+            return
+        pose_bones = evaluated.pose.bones
+        if self._holds(pose_bones):
+            return
+        changed = np.any(self.held != self.rotations, axis=1)
+        before = bulk.pose_matrices_flat(pose_bones)
+        bulk.set_pose_rotations(pose_bones, self.rotations)
+        self.pending = (depsgraph.as_pointer(), frame, changed, before)
+
+    def _was_evaluated(self, pose_bones, depsgraph, frame):
+        """After an evaluation that follows _write_evaluated: did Blender evaluate the pose with
+        the rotations written into its copy? Every bone whose rotation changed must have a new
+        matrix (a pose nothing animates is not evaluated again on a frame change). A write into
+        another depsgraph's copy (the viewport's, while a render evaluates its own) is never
+        confirmed: False, so the caller's tag has Blender copy that armature afresh."""
+        pending, self.pending = self.pending, None
+        if pending is None:
+            return True  # nothing was written into an evaluated copy
+        if pending[0] != depsgraph.as_pointer() or pending[1] != frame:
+            return False
+        _, _, changed, before = pending
+        after = bulk.pose_matrices_flat(pose_bones)
+        return bool(np.all(np.any(after[changed] != before[changed], axis=1)))
 
     @property
     def cached_frames(self):
@@ -225,7 +313,7 @@ class ArmatureRuntime:
             if self.system.recall_frame(frame, self.rotations, load_state=self.last_frame != frame):
                 self.last_frame = frame
                 self.status = "" if active_camera(scene, frame) is not None else NO_CAMERA
-                self._write(obj)
+                self._write(obj, depsgraph)
                 return
         # The frame before, from the solver's own state when it was the last one simulated (the
         # budget may already have dropped it from the cache), else the latest cached one.
@@ -263,7 +351,7 @@ class ArmatureRuntime:
             )
         self.system.store_frame(frame, self.rotations)
         self.last_frame = frame
-        self._write(obj)
+        self._write(obj, depsgraph)
 
     def weights(self, rod_index):
         slot = self.rod_slots.get(rod_index)
@@ -355,6 +443,20 @@ def evaluate_scene(scene, depsgraph=None):
                 problems.report(obj, "hair", ValueError(rt.error))
             else:
                 problems.clear(obj, "hair")
+
+
+def show_cached_frames(scene):
+    """frame_change_pre: writes the frames the caches hold before Blender evaluates them."""
+    if _replaying:
+        return
+    for obj in hair_armatures(scene):
+        rt = get(obj, build=False)
+        if rt is None:
+            continue
+        try:
+            rt.show_cached(obj, scene, scene.frame_current)
+        except Exception:  # noqa: BLE001 - frame_change_post evaluates this frame again and reports
+            continue
 
 
 def store_state(obj):
