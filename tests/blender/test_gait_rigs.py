@@ -180,8 +180,8 @@ def test_planted_joints_never_snap(empty_scene, case, fps):
     sample horse, 7.7 on the wolf), and at 60 fps none more than 3x its neighbouring
     frames' change (+1 deg) inside a stance. Not yet met, so not asserted: at 240 fps
     the fox-sized rigs (15.1 deg on the game-style rig, 13.0 on the Rigify cat at
-    0.01), and the 3x rule at the touch-down frames at 24 and 60 fps (up to 7.4x the
-    allowance on a 24 fps gallop, whose stances last 1-2 frames; docs/algorithms.md
+    0.01), and the 3x rule at the touch-down and lift-off frames at 24 and 60 fps (up to 11x the
+    allowance at 24 fps, whose gallop stances last 1-2 frames; docs/algorithms.md
     §4.8, "Touch-down at film frame rates")."""
     from kodawari.gait import runtime
 
