@@ -64,9 +64,12 @@ def _rescale(obj, scale):
     a centimetre FBX/glTF import arrives."""
     bpy.context.view_layer.objects.active = obj
     bpy.ops.object.mode_set(mode="EDIT")
-    for bone in obj.data.edit_bones:
-        bone.head = bone.head / scale
-        bone.tail = bone.tail / scale
+    bones = obj.data.edit_bones
+    # All ends read before any is written: a connected child's head is its parent's
+    # tail, so scaling bone by bone would scale that shared point twice.
+    ends = {b.name: (b.head / scale, b.tail / scale) for b in bones}
+    for bone in bones:
+        bone.head, bone.tail = ends[bone.name]
     bpy.ops.object.mode_set(mode="OBJECT")
     obj.scale = (scale, scale, scale)
 
@@ -270,13 +273,13 @@ def headings(legs):
     return h / np.linalg.norm(h, axis=1, keepdims=True)
 
 
-def planted_snaps(angles, planted, min_stance=1):
+def planted_snaps(angles, planted, min_stance=1, touchdown=False):
     """(largest planted-joint change between frames, largest ratio of a change inside a
     stance to 3x the larger of its neighbouring frames' changes + 1 deg). The ratio
     counts changes with the foot planted at both ends and planted neighbours on both
     sides, in stances of at least `min_stance` frames: a joint snapping while its foot
-    is planted. (At touch-down a leg turns from reaching forward to sweeping back
-    within a frame; that reversal is not a snap and is left out.)"""
+    is planted. With `touchdown`, the largest change also counts the change into each
+    touch-down frame (from the swing's last pose to the first planted one)."""
     import numpy as np
 
     step = np.abs(np.diff(angles, axis=0))  # (F-1, n): change from frame f to f+1
@@ -289,9 +292,10 @@ def planted_snaps(angles, planted, min_stance=1):
         runs[i:j] = j - i
         i = j
     both = planted[:-1] & planted[1:]
-    if not both.any():
+    counted = planted[1:] if touchdown else both
+    if not counted.any():
         return 0.0, 0.0
-    largest = float(step[both].max())
+    largest = float(step[counted].max())
     inside = both & (runs[:-1] >= min_stance)
     inside[1:-1] &= both[:-2] & both[2:]
     inside[[0, -1]] = False
