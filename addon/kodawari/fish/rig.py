@@ -98,9 +98,7 @@ class SwimRig:
         # (docs/algorithms.md §2.4): bound again with it, same roots and tips.
         squash = fin_setup.swing_squash(self.parts, settings.fins, self.count)
         if reach is not None and squash is not None:
-            swing_reach = fin_setup.fin_reach(
-                rest, edges, in_fin, self.body_length, kn, squash
-            )
+            swing_reach = fin_setup.fin_reach(rest, edges, in_fin, self.body_length, kn, squash)
             self.parts = self._build_parts(settings, weights, rest, reach, swing_reach)
         # Four probe points per fin part (root and one step along its tangent, side, up):
         # deformed with the body they give the body's rotation at the root.
