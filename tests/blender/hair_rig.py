@@ -93,3 +93,23 @@ def pose_curl(obj, name, axis="X", degrees=20.0):
 def run_frames(scene, first, last):
     for frame in range(first, last + 1):
         scene.frame_set(frame)
+
+
+def ahoge_under_a_moving_head(scene):
+    """The rig with a live rod on its ahoge, the head keyed to move over frames 1-24 and a
+    front camera; scene frames 1-40."""
+    obj = make_rig(scene)
+    select_only(obj, {"Ahoge.00"})
+    assert bpy.ops.kodawari.rod_add() == {"FINISHED"}
+    head = obj.pose.bones["Head"]
+    for frame, location in (
+        (1, (0, 0, 0)),
+        (8, (0.4, 0, 0.2)),
+        (16, (-0.4, 0.2, 0)),
+        (24, (0, 0, 0)),
+    ):
+        head.location = location
+        head.keyframe_insert("location", frame=frame)
+    add_camera(scene, "Front", (0, -4, 1.7))
+    scene.frame_start, scene.frame_end = 1, 40
+    return obj

@@ -3,25 +3,7 @@ a render writes what playback writes, and a cache thinned by its budget scrubs b
 
 import bpy
 import numpy as np
-from hair_rig import add_camera, make_rig, rotations, select_only
-
-
-def _setup(scene):
-    obj = make_rig(scene)
-    select_only(obj, {"Ahoge.00"})
-    assert bpy.ops.kodawari.rod_add() == {"FINISHED"}
-    head = obj.pose.bones["Head"]
-    for frame, location in (
-        (1, (0, 0, 0)),
-        (8, (0.4, 0, 0.2)),
-        (16, (-0.4, 0.2, 0)),
-        (24, (0, 0, 0)),
-    ):
-        head.location = location
-        head.keyframe_insert("location", frame=frame)
-    add_camera(scene, "Front", (0, -4, 1.7))
-    scene.frame_start, scene.frame_end = 1, 40
-    return obj
+from hair_rig import ahoge_under_a_moving_head, rotations
 
 
 def _runtime(obj):
@@ -45,7 +27,7 @@ def _restart(obj):
 
 
 def test_a_jump_in_the_timeline_gives_the_pose_playing_to_that_frame_gives(empty_scene):
-    obj = _setup(empty_scene)
+    obj = ahoge_under_a_moving_head(empty_scene)
     played = _play(empty_scene, obj, 1, 30)
     _restart(obj)
     empty_scene.frame_set(1)
@@ -65,7 +47,7 @@ def test_a_jump_in_the_timeline_gives_the_pose_playing_to_that_frame_gives(empty
 
 
 def test_scrubbing_back_into_frames_the_budget_dropped_is_exact(empty_scene):
-    obj = _setup(empty_scene)
+    obj = ahoge_under_a_moving_head(empty_scene)
     empty_scene.frame_set(1)
     rt = _runtime(obj)
     rt.system.cache_budget = 12 * rt.system.cache_bytes  # room for about a dozen frames
@@ -79,7 +61,7 @@ def test_scrubbing_back_into_frames_the_budget_dropped_is_exact(empty_scene):
 
 
 def test_rendering_the_animation_writes_the_rotations_playback_writes(empty_scene, tmp_path):
-    obj = _setup(empty_scene)
+    obj = ahoge_under_a_moving_head(empty_scene)
     scene = empty_scene
     scene.render.engine = "BLENDER_WORKBENCH"
     scene.render.resolution_x = scene.render.resolution_y = 16

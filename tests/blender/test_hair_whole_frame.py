@@ -7,25 +7,14 @@ evaluation instead, so the first evaluation is already right: every frame_change
 
 import bpy
 import numpy as np
-from hair_rig import add_camera, chain_bones, make_rig, rotations, select_only
-
-
-def _setup(scene):
-    obj = make_rig(scene)
-    select_only(obj, {"Ahoge.00"})
-    assert bpy.ops.kodawari.rod_add() == {"FINISHED"}
-    head = obj.pose.bones["Head"]
-    for frame, location in (
-        (1, (0, 0, 0)),
-        (8, (0.4, 0, 0.2)),
-        (16, (-0.4, 0.2, 0)),
-        (24, (0, 0, 0)),
-    ):
-        head.location = location
-        head.keyframe_insert("location", frame=frame)
-    add_camera(scene, "Front", (0, -4, 1.7))
-    scene.frame_start, scene.frame_end = 1, 40
-    return obj
+from hair_rig import (
+    add_camera,
+    ahoge_under_a_moving_head,
+    chain_bones,
+    make_rig,
+    rotations,
+    select_only,
+)
 
 
 def _falling(scene):
@@ -63,7 +52,7 @@ class _FirstEvaluation:
 
 def test_a_cached_frame_is_right_after_the_first_evaluation(empty_scene):
     scene = empty_scene
-    obj = _setup(scene)
+    obj = ahoge_under_a_moving_head(scene)
     played = {}
     for frame in range(1, 31):
         scene.frame_set(frame)
