@@ -177,7 +177,8 @@ class KodawariSwimSettings(bpy.types.PropertyGroup):
         name="Axis Points",
         description="How many points bend the body: more follow a long body's wave more closely",
         default=8,
-        min=4,
+        # 4-5 points (one or two B-spline spans) cannot carry a travelling wave
+        min=6,
         max=32,
         update=_rebind,
     )
