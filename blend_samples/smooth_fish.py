@@ -181,36 +181,25 @@ def build_smooth_fish(form="spindle", rings=28, segments=16, subdivisions=2, nam
                 patch,
                 [_tip_move((0, 0.4 * side, -1), 0.02, 0.35, 1, taper=0.8, sweep=(-0.5, 0, 0))] * 3,
             )
-    if f["tail"] == "caudal":
-        # Peduncle cap → a tall blade behind the body.
+    if f["tail"] in ("caudal", "fluke"):
+        # Peduncle cap → a blade behind the body, spread tall (caudal fin: z) or wide
+        # (cetacean fluke: y) over its last extrusions.
+        fluke = f["tail"] == "fluke"
+        mode = 2 if fluke else 1
         parts["fin_caudal"] = _extrude(
             bm,
             [back],
             [
-                _tip_move((-1, 0, 0), 0.02, 1.0, 1, taper=1.0),
-                _tip_move((-1, 0, 0), 0.04, 0.5, 1, taper=1.0),
-                _tip_move((-1, 0, 0.0), 0.04, 0.6, 1, taper=1.0),
+                _tip_move((-1, 0, 0), 0.02, 1.0, mode, taper=1.0),
+                _tip_move((-1, 0, 0), 0.04, 0.5, mode, taper=1.0),
+                _tip_move((-1, 0, 0), 0.04, 0.6, mode, taper=1.0),
             ],
         )
-        # Spread it tall: scale the last extrusions' verts in z.
+        spread, thin = (1, 2) if fluke else (2, 1)
         for v in parts["fin_caudal"]:
             depth = max(0.0, (0.5 - s[-1]) - v.co.x)
-            v.co.z *= 1.0 + 60.0 * depth
-            v.co.y *= max(0.3, 1.0 - 8.0 * depth)
-    elif f["tail"] == "fluke":
-        parts["fin_caudal"] = _extrude(
-            bm,
-            [back],
-            [
-                _tip_move((-1, 0, 0), 0.02, 1.0, 2, taper=1.0),
-                _tip_move((-1, 0, 0), 0.04, 0.5, 2, taper=1.0),
-                _tip_move((-1, 0, 0), 0.04, 0.6, 2, taper=1.0),
-            ],
-        )
-        for v in parts["fin_caudal"]:
-            depth = max(0.0, (0.5 - s[-1]) - v.co.x)
-            v.co.y *= 1.0 + 60.0 * depth
-            v.co.z *= max(0.3, 1.0 - 8.0 * depth)
+            v.co[spread] *= 1.0 + 60.0 * depth
+            v.co[thin] *= max(0.3, 1.0 - 8.0 * depth)
 
     mesh = bpy.data.meshes.new(name or f"{form}_smooth")
     bm.to_mesh(mesh)
