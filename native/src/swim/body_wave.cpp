@@ -153,7 +153,7 @@ std::vector<Real> fitted_offsets(const Vec3List& rest, Real body_length, const B
   Eigen::VectorXcd x = complex_fit(k);
   constexpr int kCalibrationSteps = 6;
   for (int step = 0; step < kCalibrationSteps; ++step) {
-    const Real seen = seen_wavelength(basis.cast<std::complex<Real>>() * x, s);
+    const Real seen = seen_wavelength(basis * x, s);  // real basis times complex fit, no copy
     if (!(seen > 0) || std::abs(seen / wanted - 1) < 1e-3) break;
     k *= std::clamp(seen / wanted, Real(0.5), Real(2));
     x = complex_fit(k);
