@@ -71,13 +71,6 @@ def pose_bone_matrices(pose_bones, out=None):
     return out.transpose(0, 2, 1)
 
 
-def pose_matrices_flat(pose_bones):
-    """Every pose bone's armature-space matrix as float32 (B, 16), foreach_get's layout."""
-    out = np.empty((len(pose_bones), 16), dtype=np.float32)
-    pose_bones.foreach_get("matrix", out.reshape(-1))
-    return out
-
-
 def pose_rotations(pose_bones, out):
     """Every pose bone's rotation_quaternion into float32 (B, 4) `out`."""
     pose_bones.foreach_get("rotation_quaternion", out.reshape(-1))

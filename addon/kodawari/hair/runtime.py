@@ -276,7 +276,7 @@ class ArmatureRuntime:
         if self._holds(pose_bones):
             return
         changed = np.any(self.held != self.rotations, axis=1)
-        before = bulk.pose_matrices_flat(pose_bones)
+        before = bulk.pose_bone_matrices(pose_bones)
         bulk.set_pose_rotations(pose_bones, self.rotations)
         self.pending = (depsgraph.as_pointer(), frame, changed, before)
 
@@ -292,8 +292,8 @@ class ArmatureRuntime:
         if pending[0] != depsgraph.as_pointer() or pending[1] != frame:
             return False
         _, _, changed, before = pending
-        after = bulk.pose_matrices_flat(pose_bones)
-        return bool(np.all(np.any(after[changed] != before[changed], axis=1)))
+        after = bulk.pose_bone_matrices(pose_bones)
+        return bool(np.all(np.any(after[changed] != before[changed], axis=(1, 2))))
 
     @property
     def cached_frames(self):
