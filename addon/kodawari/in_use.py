@@ -7,8 +7,9 @@ def swim(obj):
         return False
     settings = obj.kodawari_swim
     keys = obj.data.shape_keys
-    has_key = keys is not None and "Kodawari Swim" in keys.key_blocks
-    return settings.enabled or settings.baked != "NONE" or has_key
+    has_key = keys is not None and "Kodawari Swim" in keys.key_blocks  # an older file
+    has_modifier = obj.modifiers.get("Fish Swim") is not None
+    return settings.enabled or settings.baked != "NONE" or has_key or has_modifier
 
 
 def hair(obj):

@@ -4,6 +4,7 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <cmath>
 #include <memory>
 #include <optional>
 #include <stdexcept>
@@ -13,6 +14,7 @@
 #include "bind.hpp"
 #include "kodawari/ffd/bspline.hpp"
 #include "kodawari/ffd/control_axis.hpp"
+#include "kodawari/ffd/frame_table.hpp"
 #include "kodawari/ffd/frames.hpp"
 #include "kodawari/ffd/lengths.hpp"
 
@@ -89,7 +91,45 @@ void bind_ffd(py::module_& m) {
           },
           py::arg("control_points"), py::arg("out"), py::arg("twist") = py::none(), py::arg("up") = py::none(),
           py::arg("threads") = 0,
-          "Write the mesh deformed by new control points into `out` (float32 (N, 3)); the GIL is released.");
+          "Write the mesh deformed by new control points into `out` (float32 (N, 3)); the GIL is released.")
+      .def(
+          "frame_table",
+          [](const AxisBinding& b, const py::handle& control_points, const py::handle& out, const py::handle& twist,
+             const py::handle& up) {
+            const Vec3List points = to_control_points(control_points);
+            const std::vector<Real> twist_values = to_twist(twist, points.size());
+            const std::optional<Vec3> up_hint = to_up(up);
+            auto target = checked_output<float>(out, "out", 8 * ffd::kTableSegments, 3);
+            ffd::FrameTable table;
+            b.frame_table(points, twist_values, up_hint, table);
+            float* data = target.mutable_data();
+            const std::size_t n = table.size();
+            for (std::size_t i = 0; i < n; ++i) {
+              const ffd::TableSegment& s = table[i];
+              const ffd::Vec4f* fields[8] = {&s.origin, &s.d_origin, &s.e1, &s.d_e1, &s.e2, &s.d_e2, &s.e3, &s.d_e3};
+              for (std::size_t f = 0; f < 8; ++f) {
+                for (int k = 0; k < 3; ++k) data[3 * (f * n + i) + k] = (*fields[f])[k];
+              }
+            }
+          },
+          py::arg("control_points"), py::arg("out"), py::arg("twist") = py::none(), py::arg("up") = py::none(),
+          "Write the frame table deform() uses into `out`, float32 (8 * 1024, 3): origin, its change across each "
+          "segment, e1, its change, e2, its change, e3, its change; 1024 rows each.")
+      .def(
+          "packed_coordinates",
+          [](const AxisBinding& b, double end_scale) {
+            if (!(end_scale > 0) || !std::isfinite(end_scale)) throw py::value_error("end_scale must be > 0");
+            py::array_t<float> out({static_cast<py::ssize_t>(b.count()), py::ssize_t(3)});
+            float* data = out.mutable_data();
+            {
+              py::gil_scoped_release release;
+              b.packed_coordinates(static_cast<float>(end_scale), data);
+            }
+            return out;
+          },
+          py::arg("end_scale"),
+          "float32 (N, 3): (s, u, v) per vertex, s = segment + fraction, or beyond an end w * end_scale "
+          "(head) / 1024 + w * end_scale (tail).");
 
   m.def(
       "ffd_bind",

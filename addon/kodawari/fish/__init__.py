@@ -1,7 +1,8 @@
 """Fish swim: any fish mesh swims by bending along a control axis (docs/algorithms.md §1, §2).
 
-Object.kodawari_swim holds the settings; runtime.py evaluates into the "Kodawari Swim"
-shape key, called by handlers.py on frame changes; ops.py adds, tunes, bakes and removes.
+Object.kodawari_swim holds the settings; runtime.py writes each frame into the Fish Swim
+Geometry Nodes modifier (route.py), called by handlers.py on frame changes; ops.py adds,
+tunes, bakes and removes.
 """
 
 import bpy

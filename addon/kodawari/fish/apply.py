@@ -22,7 +22,7 @@ class KODAWARI_OT_swim_apply(bpy.types.Operator):
             self.report({"ERROR"}, error)
             return {"CANCELLED"}
         try:
-            positions = runtime.evaluate(obj, context.scene).copy()
+            positions = runtime.positions(obj, context.scene).copy()
         except ValueError as exc:
             self.report({"ERROR"}, tip_("Cannot apply the swim of '{}': {}").format(obj.name, exc))
             return {"CANCELLED"}
@@ -47,11 +47,13 @@ def _refusal(obj):
         return tip_("'{}' is baked: remove or free the bake before applying the swim").format(
             obj.name
         )
-    if runtime.swim_key_block(obj) is None:
+    if not runtime.has_swim(obj):
         return tip_("'{}' has no Fish Swim to apply").format(obj.name)
     keys = obj.data.shape_keys
     others = [
-        b.name for b in keys.key_blocks if b.name != runtime.SHAPE_KEY and b != keys.reference_key
+        b.name
+        for b in (keys.key_blocks if keys is not None else ())
+        if b.name != runtime.SHAPE_KEY and b != keys.reference_key
     ]
     if others:
         return tip_(

@@ -15,10 +15,11 @@ from bpy.app.translations import pgettext_tip as tip_
 
 from .. import cache_paths, editable, fcurves
 from ..bake_job import BakeError, BakeJob
-from . import runtime
+from . import runtime, visibility
 
 CACHE_MODIFIER = "Kodawari Swim Cache"
 BAKED_KEY_PREFIX = "Kodawari Swim "
+ADDED_BASIS = "kodawari_swim_basis"  # mesh property: a SHAPE_KEYS bake added the Basis
 TRAVEL_GROUP = "Kodawari Swim"  # the F-curve group of the baked travel
 
 
@@ -90,7 +91,7 @@ class SwimBakeJob(BakeJob):
         frame = self.frames[self.index]
         self.stepped = True
         self.scene.frame_set(frame)
-        positions = runtime.evaluate(self.obj, self.scene, frame)
+        positions = runtime.positions(self.obj, self.scene, frame)
         if self.handle is not None:
             self.handle.write(np.ascontiguousarray(positions, dtype="<f4").tobytes())
         else:
@@ -125,7 +126,6 @@ class SwimBakeJob(BakeJob):
     def finish(self):
         obj = self.obj
         settings = obj.kodawari_swim
-        block = runtime.swim_key_block(obj)
         if self.target == "MESH_CACHE":
             # The file first: a failing rename leaves the object untouched (cancel cleans up).
             self.handle.close()
@@ -148,6 +148,11 @@ class SwimBakeJob(BakeJob):
                 obj.modifiers.move(list(obj.modifiers).index(modifier), 0)
             settings.cache_path = modifier.filepath
         else:
+            if obj.data.shape_keys is None:
+                # Baked keys are relative to a Basis: the rest shape. Ours, so Free Bake
+                # takes it away again.
+                obj.shape_key_add(name="Basis", from_mix=False)
+                obj.data[ADDED_BASIS] = True
             key = obj.data.shape_keys
             first, last = self.frames[0], self.frames[-1]
             action = fcurves.ensure_action(key, "Kodawari Swim Bake")
@@ -176,9 +181,8 @@ class SwimBakeJob(BakeJob):
                 values,
                 group=TRAVEL_GROUP,
             )
-        if block is not None:
-            block.value = 0.0
         settings.baked = self.target
+        visibility.sync(obj)  # the modifier off: the bake plays
         with runtime.batch(obj):
             settings.enabled = self.was_enabled
         self.was_enabled = None
@@ -208,24 +212,33 @@ def free_bake(obj):
                 os.remove(bpy.path.abspath(path))
             except OSError:
                 pass  # already gone, or not ours to delete: the modifier is what mattered
-    keys = obj.data.shape_keys
-    if keys is not None:
-        baked = [b for b in keys.key_blocks if b.name.startswith(BAKED_KEY_PREFIX)]
-        anim = keys.animation_data
-        for block in baked:
-            if anim is not None and anim.action is not None:
-                curve = fcurves.find_fcurve(anim.action, keys, f'key_blocks["{block.name}"].value')
-                if curve is not None:
-                    fcurves.remove_fcurve(anim.action, keys, curve)
-            obj.shape_key_remove(block)
+    free_bake_keys(obj)
     anim = obj.animation_data
     if anim is not None and anim.action is not None:
         for curve in list(fcurves.action_fcurves(anim.action, obj)):
             if curve.group is not None and curve.group.name == TRAVEL_GROUP:
                 fcurves.remove_fcurve(anim.action, obj, curve)
     obj.delta_location = settings.rest_delta_location
-    block = runtime.swim_key_block(obj)
-    if block is not None:
-        block.value = 1.0
     settings.cache_path = ""
     settings.baked = "NONE"
+    visibility.sync(obj)  # the modifier on again, as the settings say
+
+
+def free_bake_keys(obj):
+    """Remove the baked shape keys and their F-curves, and the Basis a bake added."""
+    keys = obj.data.shape_keys
+    if keys is None:
+        return
+    baked = [b for b in keys.key_blocks if b.name.startswith(BAKED_KEY_PREFIX)]
+    anim = keys.animation_data
+    for block in baked:
+        if anim is not None and anim.action is not None:
+            curve = fcurves.find_fcurve(anim.action, keys, f'key_blocks["{block.name}"].value')
+            if curve is not None:
+                fcurves.remove_fcurve(anim.action, keys, curve)
+        obj.shape_key_remove(block)
+    keys = obj.data.shape_keys
+    if obj.data.get(ADDED_BASIS):
+        if keys is not None and len(keys.key_blocks) == 1:
+            obj.shape_key_remove(keys.key_blocks[0])
+        del obj.data[ADDED_BASIS]

@@ -12,7 +12,10 @@ from . import runtime, visibility
 def on_frame_change(scene, depsgraph=None):
     runtime.separate_linked_duplicates(scene)
     for obj in scene.objects:
-        if obj.type != "MESH" or not runtime.is_live(obj):
+        if obj.type != "MESH":
+            continue
+        visibility.pull(obj)  # a click on the Fish Swim modifier's own eye or camera
+        if not runtime.is_live(obj):
             continue
         try:
             runtime.evaluate(obj, scene)

@@ -9,12 +9,11 @@ from bpy.props import EnumProperty, FloatProperty, IntProperty, StringProperty
 
 from .. import bulk, cache_paths, editable, fcurves, native
 from ..bake_job import BakeError, BakeOperator, frame_range
-from . import bake, finder, midline, presets, runtime, validate
+from . import bake, finder, midline, presets, route, runtime, validate
 from . import fins as fin_setup
 from . import rig as rig_module
 from .props import HEAD_AXES
 
-SHAPE_KEY = rig_module.SHAPE_KEY
 
 
 def _active_mesh(context):
@@ -56,7 +55,7 @@ class KODAWARI_OT_swim_add(bpy.types.Operator):
             and (
                 obj.kodawari_swim.enabled
                 or obj.kodawari_swim.baked != "NONE"
-                or runtime.swim_key_block(obj) is not None
+                or runtime.has_swim(obj)
             )
         ):
             error = f"'{obj.name}' already swims: tune it in the Modifier tab, or remove it first"
@@ -99,16 +98,12 @@ class KODAWARI_OT_swim_add(bpy.types.Operator):
                 settings.frequency = self.frequency
             settings.rest_delta_location = obj.delta_location
             settings.baked = "NONE"
-            obj.shape_key_add(name="Basis", from_mix=False)
-            key = obj.shape_key_add(name=SHAPE_KEY, from_mix=False)
-            key.value = 1.0
-            # Edit Mode edits the active key: keep it on the Basis, the rest shape.
-            obj.active_shape_key_index = 0
             settings.enabled = True
-        # The handler writes the shape key on frame changes; renders must wait for it.
+        # The handler writes the modifier's frame on frame changes; renders must wait for it.
         context.scene.render.use_lock_interface = True
         runtime.forget(obj)
         runtime.adopt(obj, trial_rig)  # the trial bind is the binding: no second one
+        runtime.ensure_route(obj, runtime.get_rig(obj))
         runtime.evaluate(obj, context.scene)
         self.report(
             {"INFO"},
@@ -123,20 +118,12 @@ def remove_swim(obj):
     """Undo everything swim_add, swim_fin_add and swim_bake did to the object."""
     settings = obj.kodawari_swim
     runtime.forget(obj)
+    route.uninstall(obj)
     modifier = obj.modifiers.get(bake.CACHE_MODIFIER)
     if modifier is not None:
         obj.modifiers.remove(modifier)
-    keys = obj.data.shape_keys
-    if keys is not None:
-        for block in [
-            b
-            for b in keys.key_blocks
-            if b.name == SHAPE_KEY or b.name.startswith(bake.BAKED_KEY_PREFIX)
-        ]:
-            obj.shape_key_remove(block)
-        keys = obj.data.shape_keys
-        if keys is not None and len(keys.key_blocks) == 1:
-            obj.shape_key_remove(keys.key_blocks[0])  # only the Basis we added is left
+    bake.free_bake_keys(obj)  # baked keys, and the Basis a bake added
+    runtime.drop_swim_key(obj)  # an older file's swim key, and the Basis added with it
     anim = obj.animation_data
     if anim is not None and anim.action is not None:
         for fcurve in fcurves.action_fcurves(anim.action, obj):
@@ -165,7 +152,7 @@ class KODAWARI_OT_swim_remove(bpy.types.Operator):
         if (
             not settings.enabled
             and settings.baked == "NONE"
-            and runtime.swim_key_block(obj) is None
+            and not runtime.has_swim(obj)
         ):
             self.report({"ERROR"}, tip_("'{}' has no Fish Swim to remove").format(obj.name))
             return {"CANCELLED"}
@@ -240,7 +227,7 @@ def add_fin(obj, group_name, kind, rebind=True):
 def _needs_swim(obj):
     if obj is None or obj.type != "MESH":
         return tip_("Select the swimming mesh object first")
-    if runtime.swim_key_block(obj) is None:  # hidden in the viewport (enabled off) still swims
+    if not runtime.has_swim(obj):  # hidden in the viewport (enabled off) still swims
         return tip_("'{}' does not swim yet: Add Fish Swim first").format(obj.name)
     return editable.why_not(obj, tip_("change its swim"))
 

@@ -11,7 +11,8 @@ from .. import bulk, native
 from . import fins as fin_setup
 from . import midline
 
-SHAPE_KEY = "Kodawari Swim"
+SHAPE_KEY = "Kodawari Swim"  # the swim's shape key before the node route (kept for old files)
+TABLE_SEGMENTS = 1024  # the core's frame table (native/include/kodawari/ffd/frame_table.hpp)
 PROBE_SCALE = (
     0.02  # probe arm length (fraction of body length) for the body's rotation at a fin root
 )
@@ -112,6 +113,14 @@ class SwimRig:
                 part.root + arm * part.up,
             ]
         self.probe_arm = arm
+        # The route (route.py) reads fin offsets per fin vertex: every part's vertices, once.
+        self.fin_vertices = None
+        if self.parts:
+            self.fin_vertices = np.unique(np.concatenate([p.indices for p in self.parts]))
+            for part in self.parts:
+                part.slots = np.searchsorted(self.fin_vertices, part.indices)
+            self.fin_offsets = np.zeros((len(self.fin_vertices), 3), dtype=np.float32)
+        self.table = np.empty((8 * TABLE_SEGMENTS, 3), dtype=np.float32)
         if probes:
             self.probes_rest = np.ascontiguousarray(probes, dtype=np.float32)
             self.probe_binding = kn.ffd_bind(self.axis_rest, self.probes_rest, up=self.up)
@@ -159,6 +168,29 @@ class SwimRig:
             preserve_length=settings.preserve_length,
         )
 
+    @property
+    def end_scale(self):
+        """How w beyond the body's ends is packed into s (docs/algorithms.md §1.6): one
+        table segment per 1/1024 of the body length, as along it."""
+        return TABLE_SEGMENTS / max(float(self.body_length), 1e-12)
+
+    def packed_coordinates(self):
+        """float32 (N, 3): each vertex's (s, u, v), the route's bound attribute."""
+        return self.binding.packed_coordinates(self.end_scale)
+
+    def frame(self, settings, phase, rest_axis=None):
+        """What the route needs for one frame: the frame table (float32 (8 * 1024, 3)) and
+        the fin vertices' offsets (float32 (M, 3), or None without fins), the same the
+        core's deform and fin displacement give evaluate()."""
+        self.axis = self.body_axis(settings, phase, rest_axis)
+        self.binding.frame_table(self.axis, self.table)
+        if not self.parts:
+            return self.table, None
+        self.fin_offsets[:] = 0.0
+        for part in self._moving_parts(settings, phase):
+            self.fin_offsets[part.slots] += part.out
+        return self.table, self.fin_offsets
+
     def evaluate(self, settings, phase, rest_axis=None, out=None):
         """Deformed positions float32 (N, 3) for the phase (radians, accumulated), written into
         `out` (e.g. the shape key's memory) or the rig's own buffer; `rest_axis` replaces the
@@ -172,6 +204,12 @@ class SwimRig:
         self.binding.deform(self.axis, positions)
         if not self.parts:
             return positions
+        for part in self._moving_parts(settings, phase):
+            positions[part.indices] += part.out
+        return positions
+
+    def _moving_parts(self, settings, phase):
+        """Each moving fin part, its displacement for the phase just written to part.out."""
         self.probe_binding.deform(self.axis, self.probes_out)
         for k, part in enumerate(self.parts):
             fin = settings.fins[part.fin_index]
@@ -197,5 +235,5 @@ class SwimRig:
                 self.probes_out[4 * k : 4 * k + 4],
                 part.out,
             )
-            positions[part.indices] += part.out
-        return positions
+            yield part
+

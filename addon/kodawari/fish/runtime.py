@@ -1,6 +1,8 @@
-"""Live evaluation: writes each swimming object's deformed positions into its
-"Kodawari Swim" shape key (handlers.py calls it on frame changes and file loads;
-a load drops the runtime state so it is rebuilt from the saved settings).
+"""Live evaluation: writes each swimming object's frame (the control axis's frame table
+and the fin offsets) into its Fish Swim modifier's helpers, and Blender bends the mesh
+in its own evaluation (route.py, docs/algorithms.md §1.6). handlers.py calls it on frame
+changes and file loads; a load drops the runtime state so it is rebuilt from the saved
+settings. positions() gives the same shape as float32 positions (bake, apply).
 
 Runtime state (the bound rigs) lives only in memory, keyed by object; anything
 that could make it stale (undo, a new file, changed binding settings, another
@@ -13,7 +15,7 @@ import bpy
 import mathutils
 
 from .. import bulk, problems
-from . import path, timing, visibility
+from . import path, route, timing, visibility
 from . import rig as rig_module
 
 SHAPE_KEY = rig_module.SHAPE_KEY
@@ -93,20 +95,47 @@ def batch(obj):
 
 
 def swim_key_block(obj):
+    """The shape key the swim lived in before the node route (an older file), or None."""
     keys = obj.data.shape_keys
     return keys.key_blocks.get(SHAPE_KEY) if keys is not None else None
 
 
+def has_swim(obj):
+    """The object has a live swim set up (its Fish Swim modifier, or an older file's key)."""
+    return route.modifier(obj) is not None or swim_key_block(obj) is not None
+
+
 def is_live(obj):
-    # Not in Edit Mode: there the user edits the shape key, and leaving rewrites it.
+    # Not in Edit Mode: there the user edits the rest shape (the modifier shows it).
     return (
         obj is not None
         and obj.type == "MESH"
         and obj.mode != "EDIT"
         and visibility.visible(obj)
         and obj.kodawari_swim.baked == "NONE"
-        and swim_key_block(obj) is not None
+        and has_swim(obj)
     )
+
+
+def drop_swim_key(obj):
+    """An older file's swim shape key (and the Basis added with it, when alone) goes: the
+    modifier bends the mesh now."""
+    block = swim_key_block(obj)
+    if block is None:
+        return
+    obj.shape_key_remove(block)
+    keys = obj.data.shape_keys
+    if keys is not None and len(keys.key_blocks) == 1:
+        obj.shape_key_remove(keys.key_blocks[0])
+
+
+def ensure_route(obj, rig):
+    """The route installed for this rig's binding (installed again after a rebind)."""
+    if route.installed_for(obj, rig):
+        return
+    drop_swim_key(obj)
+    route.install(obj, rig)
+    visibility.sync(obj)
 
 
 def travel_direction(obj, rig):
@@ -120,10 +149,9 @@ def apply_travel(obj, rig, distance):
     obj.delta_location = rest + travel_direction(obj, rig) * distance
 
 
-def evaluate(obj, scene, frame=None):
-    """Deform one object for a frame (the scene's current frame by default) into its swim shape
-    key; returns the positions: a view of the key's own memory (copy it to keep it) or the
-    rig's buffer."""
+def _pose(obj, scene, frame):
+    """(rig, settings, phase, rest axis or None) for a frame, the object placed on its
+    travel or path."""
     settings = obj.kodawari_swim
     rig = get_rig(obj)
     if frame is None:
@@ -142,16 +170,24 @@ def evaluate(obj, scene, frame=None):
         )
     elif settings.speed_mode != "NONE":
         apply_travel(obj, rig, distance)
-    block = swim_key_block(obj)
-    # Deform straight into the key where its memory can be reached: no (N, 3) buffer of our
-    # own and no copy per frame; else into the rig's buffer, then foreach_set.
-    view = bulk.shape_key_view(block) if block is not None else None
-    positions = rig.evaluate(settings, phase, rest_axis, out=view)
-    if view is not None:
-        bulk.tag_shape_key(block)
-    elif block is not None:
-        bulk.write_shape_key_positions(block, positions)
-    return positions
+    return rig, settings, phase, rest_axis
+
+
+def evaluate(obj, scene, frame=None):
+    """Pose one object for a frame (the scene's current frame by default): its frame table
+    and fin offsets go into the Fish Swim modifier's helpers, and Blender bends the mesh
+    when it evaluates it (route.py). Installs the route when the binding changed."""
+    rig, settings, phase, rest_axis = _pose(obj, scene, frame)
+    ensure_route(obj, rig)
+    table, fin_offsets = rig.frame(settings, phase, rest_axis)
+    route.write_frame(obj, table, fin_offsets)
+
+
+def positions(obj, scene, frame=None):
+    """The shape the modifier gives at a frame, as float32 (N, 3) positions computed by the
+    core (bake, apply): the rig's buffer, copy it to keep it."""
+    rig, settings, phase, rest_axis = _pose(obj, scene, frame)
+    return rig.evaluate(settings, phase, rest_axis)
 
 
 def refresh(obj):
@@ -181,14 +217,25 @@ def rebind(obj, known_weights=None):
 
 
 def separate_linked_duplicates(scene):
-    """Linked duplicates (Alt-D) share one mesh and so one swim shape key: each would
-    overwrite the other. Give every live swimmer after the first its own copy of the
-    mesh (what Object > Relations > Make Single User does) so each swims with its own
-    settings, and say so in the console."""
+    """Linked duplicates (Alt-D) share one mesh and its bound attributes, and a duplicate
+    (Shift-D) shares the Fish Swim node group and its helpers: each would overwrite the
+    other's frame. Give every live swimmer after the first its own copy of the mesh (what
+    Object > Relations > Make Single User does) or of the route, so each swims with its
+    own settings, and say so in the console."""
     owners = {}
+    groups = {}
     for obj in sorted(scene.objects, key=lambda o: o.name):
         if obj.type != "MESH" or not is_live(obj) or obj.data.library is not None:
             continue
+        mod = route.modifier(obj)
+        if mod is not None:
+            group_owner = groups.setdefault(mod.node_group.as_pointer(), obj)
+            if group_owner is not obj:
+                forget(obj)  # its next evaluate installs its own group and helpers
+                print(
+                    f"Kodawari Swim: '{obj.name}' shared its Fish Swim helpers with "
+                    f"'{group_owner.name}' (a duplicate); it now has its own"
+                )
         owner = owners.setdefault(obj.data.as_pointer(), obj)
         if owner is not obj:
             try:

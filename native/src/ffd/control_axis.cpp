@@ -165,8 +165,8 @@ float AxisBinding::parameter(std::size_t i) const {
   return static_cast<float>((Real(c.segment) + Real(c.fraction)) / kTableSegments);
 }
 
-void AxisBinding::deform(const Vec3List& control_points, const std::vector<Real>& twist,
-                         const std::optional<Vec3>& up, float* out, unsigned threads) const {
+void AxisBinding::frame_table(const Vec3List& control_points, const std::vector<Real>& twist,
+                              const std::optional<Vec3>& up, FrameTable& table) const {
   validate_control_points(control_points, "control_points");
   if (static_cast<int>(control_points.size()) != control_point_count_) {
     throw std::invalid_argument("control_points must have " + std::to_string(control_point_count_) +
@@ -181,9 +181,32 @@ void AxisBinding::deform(const Vec3List& control_points, const std::vector<Real>
   const Vec3 normal = up ? start_normal_from_up(*up, tangent) : carry_normal(rest_normal_, rest_tangent_, tangent);
   FrameList frames;
   rotation_minimising_frames(sampled, normal, frames);
-  FrameTable table;
   fill_frame_table(frames, table);
   require_finite_positions(table, reach_);
+}
+
+void AxisBinding::packed_coordinates(float end_scale, float* out) const {
+  for (std::size_t i = 0; i < coordinates_.size(); ++i) {
+    const AxisCoordinate& c = coordinates_[i];
+    float s = static_cast<float>(c.segment) + c.fraction;
+    if (c.w != 0.0f) {
+      // Only a vertex at an end has w != 0: before the head w <= 0 (its closest curve
+      // point is the head, so it lies behind the head's tangent plane), after the
+      // tail w >= 0. The sign keeps s outside [0, kTableSegments], where the reader
+      // finds w again as (s - clamp(s)) / end_scale.
+      const bool head = c.segment == 0 && c.fraction == 0.0f;
+      s = head ? std::min(c.w, 0.0f) * end_scale : float(kTableSegments) + std::max(c.w, 0.0f) * end_scale;
+    }
+    out[3 * i] = s;
+    out[3 * i + 1] = c.u;
+    out[3 * i + 2] = c.v;
+  }
+}
+
+void AxisBinding::deform(const Vec3List& control_points, const std::vector<Real>& twist,
+                         const std::optional<Vec3>& up, float* out, unsigned threads) const {
+  FrameTable table;
+  frame_table(control_points, twist, up, table);
 
   const AxisCoordinate* coords = coordinates_.data();
   const TableSegment* segments = table.data();

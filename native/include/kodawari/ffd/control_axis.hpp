@@ -44,6 +44,18 @@ class AxisBinding {
   void deform(const Vec3List& control_points, const std::vector<Real>& twist, const std::optional<Vec3>& up,
               float* out, unsigned threads = 0) const;
 
+  // The frame table deform() would use for these control points (same checks, same
+  // arithmetic): what a deformer outside the core (a Geometry Nodes modifier,
+  // docs/algorithms.md §1.6) needs per frame to give deform()'s positions.
+  void frame_table(const Vec3List& control_points, const std::vector<Real>& twist, const std::optional<Vec3>& up,
+                   FrameTable& table) const;
+
+  // Each vertex's coordinates packed into three floats (docs/algorithms.md §1.6):
+  // (s, u, v) with s = segment + fraction inside the table and, for a vertex beyond an
+  // end (the only ones with w != 0), s = w * end_scale before the head or
+  // kTableSegments + w * end_scale after the tail. Writes 3 * count() floats.
+  void packed_coordinates(float end_scale, float* out) const;
+
  private:
   int control_point_count_ = 0;
   UniformCurveSampler sampler_;

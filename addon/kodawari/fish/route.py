@@ -1,0 +1,276 @@
+"""Fish Swim as a Geometry Nodes modifier (docs/algorithms.md §1.6).
+
+The live swim bends the fish inside Blender's own evaluation: a "Fish Swim" Geometry
+Nodes modifier, first in the stack, reads each vertex's bound FFD coordinates (one
+3-float attribute, bound once) and the current frame table (1024 segments x 8 vectors,
+written per frame into a small helper mesh) and sets the bent positions with Sample
+Index nodes. Moving fins add a per-vertex offset the core computes per frame for the
+fin vertices only, written into a second helper mesh and read by an index attribute.
+
+The helpers (node group, helper objects and meshes) are named with a leading dot, which
+Blender leaves out of its ID menus; the helper objects belong to no collection, so the
+Outliner's scene views do not show them. They are reached from the modifier alone (no
+name lookups), save with the .blend, and go with Remove Fish Swim. The node tree is built
+here in code from nodes Blender 3.4 already has (no rotation or matrix sockets).
+"""
+
+import bpy
+import numpy as np
+
+MODIFIER = "Fish Swim"
+GROUP = ".Kodawari Fish Swim"
+TABLE = ".Kodawari Fish Swim Frames"
+FINS = ".Kodawari Fish Swim Fins"
+COORDINATES = ".kodawari_swim_ffd"  # float3 per vertex: (s, u, v), docs/algorithms.md §1.6
+FIN_INDEX = ".kodawari_swim_fin"  # int per vertex: its row in the fin helper, -1 off the fins
+FIN_OFFSET = "offset"
+SEGMENTS = 1024
+FIELDS = ("o", "do", "e1", "de1", "e2", "de2", "e3", "de3")  # rows of AxisBinding.frame_table
+
+
+def modifier(obj):
+    """The object's Fish Swim modifier (a Geometry Nodes modifier running our group)."""
+    mod = obj.modifiers.get(MODIFIER)
+    if mod is None or mod.type != "NODES" or mod.node_group is None:
+        return None
+    return mod if mod.node_group.get("kodawari_swim") else None
+
+
+def _helper(group, label):
+    node = group.nodes.get(label)
+    return node.inputs[0].default_value if node is not None else None
+
+
+def helpers(obj):
+    """(frame table mesh, fin offset mesh or None) of the object's Fish Swim, or (None, None)."""
+    mod = modifier(obj)
+    if mod is None:
+        return None, None
+    table = _helper(mod.node_group, "frames")
+    fins = _helper(mod.node_group, "fins")
+    return (
+        table.data if table is not None else None,
+        fins.data if fins is not None else None,
+    )
+
+
+# ----------------------------------------------------------------------------- the tree
+
+
+def _new_socket(group, name, in_out):
+    if hasattr(group, "interface"):  # 4.0+
+        group.interface.new_socket(name=name, in_out=in_out, socket_type="NodeSocketGeometry")
+    else:  # 3.x
+        (group.inputs if in_out == "INPUT" else group.outputs).new("NodeSocketGeometry", name)
+
+
+def _enabled(sockets, name=None):
+    return next(s for s in sockets if s.enabled and (name is None or s.name == name))
+
+
+class _Tree:
+    def __init__(self, group):
+        self.nodes, self.links = group.nodes, group.links
+
+    def node(self, kind, **props):
+        node = self.nodes.new(kind)
+        for key, value in props.items():
+            setattr(node, key, value)
+        return node
+
+    def named(self, name, data_type):
+        node = self.node("GeometryNodeInputNamedAttribute", data_type=data_type)
+        node.inputs["Name"].default_value = name
+        return _enabled(node.outputs)
+
+    def math(self, operation, a, b):
+        node = self.node("ShaderNodeMath", operation=operation)
+        for socket, value in zip(node.inputs, (a, b)):
+            if isinstance(value, float):
+                socket.default_value = value
+            else:
+                self.links.new(value, socket)
+        return node.outputs[0]
+
+    def multiply_add(self, a, scalar, c):
+        node = self.node("ShaderNodeVectorMath", operation="MULTIPLY_ADD")
+        self.links.new(a, node.inputs[0])
+        self.links.new(scalar, node.inputs[1])  # a float into a vector socket: (s, s, s)
+        self.links.new(c, node.inputs[2])
+        return node.outputs[0]
+
+    def sample(self, geometry, attribute, index):
+        node = self.node("GeometryNodeSampleIndex", data_type="FLOAT_VECTOR", domain="POINT")
+        self.links.new(geometry, node.inputs["Geometry"])
+        self.links.new(self.named(attribute, "FLOAT_VECTOR"), _enabled(node.inputs, "Value"))
+        self.links.new(index, node.inputs["Index"])
+        return _enabled(node.outputs)
+
+    def object_geometry(self, label, obj):
+        info = self.node("GeometryNodeObjectInfo", name=label, label=label)
+        info.inputs["Object"].default_value = obj
+        return info.outputs["Geometry"]
+
+
+def build_group(table_obj, fins_obj, end_scale):
+    """P' = (O + u e2 + v e3 + w e1) + f (dO + u de2 + v de3 + w de1) [+ fin offset], the
+    core's deform_vertex (docs/algorithms.md §1.4, §1.6) in nodes."""
+    group = bpy.data.node_groups.new(GROUP, "GeometryNodeTree")
+    group["kodawari_swim"] = 1
+    _new_socket(group, "Geometry", "INPUT")
+    _new_socket(group, "Geometry", "OUTPUT")
+    tree = _Tree(group)
+    group_in, group_out = tree.node("NodeGroupInput"), tree.node("NodeGroupOutput")
+    table = tree.object_geometry("frames", table_obj)
+    split = tree.node("ShaderNodeSeparateXYZ")
+    tree.links.new(tree.named(COORDINATES, "FLOAT_VECTOR"), split.inputs[0])
+    s, u, v = split.outputs["X"], split.outputs["Y"], split.outputs["Z"]
+    t = tree.node("ShaderNodeClamp")
+    tree.links.new(s, t.inputs["Value"])
+    t.inputs["Min"].default_value, t.inputs["Max"].default_value = 0.0, float(SEGMENTS)
+    t = t.outputs[0]
+    # Beyond an end the packing keeps w outside [0, 1024]: w = (s - clamp(s)) / end_scale.
+    w = tree.math("MULTIPLY", tree.math("SUBTRACT", s, t), 1.0 / end_scale)
+    segment = tree.math("MINIMUM", tree.math("FLOOR", t, 0.0), float(SEGMENTS - 1))
+    fraction = tree.math("SUBTRACT", t, segment)
+    row = {name: tree.sample(table, name, segment) for name in FIELDS}
+    at = tree.multiply_add(row["e2"], u, row["o"])
+    at = tree.multiply_add(row["e3"], v, at)
+    at = tree.multiply_add(row["e1"], w, at)
+    change = tree.multiply_add(row["de2"], u, row["do"])
+    change = tree.multiply_add(row["de3"], v, change)
+    change = tree.multiply_add(row["de1"], w, change)
+    moved = tree.multiply_add(change, fraction, at)
+    if fins_obj is not None:
+        # Off the fins the index is -1: Sample Index gives a zero offset out of range.
+        offset = tree.sample(
+            tree.object_geometry("fins", fins_obj), FIN_OFFSET, tree.named(FIN_INDEX, "INT")
+        )
+        add = tree.node("ShaderNodeVectorMath", operation="ADD")
+        tree.links.new(moved, add.inputs[0])
+        tree.links.new(offset, add.inputs[1])
+        moved = add.outputs[0]
+    set_position = tree.node("GeometryNodeSetPosition")
+    tree.links.new(group_in.outputs[0], set_position.inputs["Geometry"])
+    tree.links.new(moved, set_position.inputs["Position"])
+    tree.links.new(set_position.outputs[0], group_out.inputs[0])
+    return group
+
+
+# ----------------------------------------------------------------------------- set-up
+
+
+def _helper_object(name, count, attributes):
+    mesh = bpy.data.meshes.new(name)
+    mesh.vertices.add(count)
+    for attribute in attributes:
+        mesh.attributes.new(attribute, "FLOAT_VECTOR", "POINT")
+    return bpy.data.objects.new(name, mesh)  # in no collection: not in the scene's Outliner
+
+
+def _move_first(obj, mod):
+    index = list(obj.modifiers).index(mod)
+    if index == 0:
+        return
+    if hasattr(obj.modifiers, "move"):  # 4.0+
+        obj.modifiers.move(index, 0)
+        return
+    with bpy.context.temp_override(object=obj, active_object=obj):
+        bpy.ops.object.modifier_move_to_index(modifier=mod.name, index=0)
+
+
+def _remove_helpers(mod):
+    group = mod.node_group
+    mod.node_group = None
+    if group is None or group.users > 0:
+        return  # shared with a duplicate (Shift-D): its helpers stay with it
+    for label in ("frames", "fins"):
+        helper = _helper(group, label)
+        if helper is not None:
+            mesh = helper.data
+            bpy.data.objects.remove(helper)
+            if mesh is not None and mesh.users == 0:
+                bpy.data.meshes.remove(mesh)
+    if group.users == 0:
+        bpy.data.node_groups.remove(group)
+
+
+def _write_attribute(mesh, name, kind, values):
+    attribute = mesh.attributes.get(name)
+    if attribute is not None and (attribute.data_type != kind or attribute.domain != "POINT"):
+        mesh.attributes.remove(attribute)
+        attribute = None
+    if attribute is None:
+        attribute = mesh.attributes.new(name, kind, "POINT")
+    attribute.data.foreach_set("vector" if kind == "FLOAT_VECTOR" else "value", values.reshape(-1))
+
+
+def install(obj, rig, show_viewport=True, show_render=True):
+    """Bind the route to the object's mesh for `rig` (runtime.SwimRig): the coordinate
+    attributes, the helpers and the modifier, first in the stack. Replaces an earlier
+    installation (a rebind)."""
+    mesh = obj.data
+    mod = obj.modifiers.get(MODIFIER)
+    if mod is not None and mod.type == "NODES":
+        _remove_helpers(mod)
+    else:
+        mod = obj.modifiers.new(MODIFIER, "NODES")
+    _write_attribute(mesh, COORDINATES, "FLOAT_VECTOR", rig.packed_coordinates())
+    table_obj = _helper_object(TABLE, SEGMENTS, FIELDS)
+    fins_obj = None
+    if rig.fin_vertices is not None:
+        index = np.full(len(mesh.vertices), -1, np.int32)
+        index[rig.fin_vertices] = np.arange(len(rig.fin_vertices), dtype=np.int32)
+        _write_attribute(mesh, FIN_INDEX, "INT", index)
+        fins_obj = _helper_object(FINS, len(rig.fin_vertices), (FIN_OFFSET,))
+    elif mesh.attributes.get(FIN_INDEX) is not None:
+        mesh.attributes.remove(mesh.attributes[FIN_INDEX])
+    mod.node_group = build_group(table_obj, fins_obj, rig.end_scale)
+    # In Edit Mode the user edits the rest shape: show it, as the shape key used to.
+    mod.show_in_editmode = False
+    mod.show_viewport, mod.show_render = show_viewport, show_render
+    _move_first(obj, mod)
+    rig.installed_on = mesh.as_pointer()
+    return mod
+
+
+def installed_for(obj, rig):
+    """True when the object's route was installed for this very rig (same binding)."""
+    mod = modifier(obj)
+    if mod is None or getattr(rig, "installed_on", None) != obj.data.as_pointer():
+        return False
+    attribute = obj.data.attributes.get(COORDINATES)
+    return attribute is not None and (rig.fin_vertices is None) == (
+        obj.data.attributes.get(FIN_INDEX) is None
+    )
+
+
+def uninstall(obj):
+    """Remove the modifier, its node group, the helpers and the attributes: the mesh is as
+    it was before the swim."""
+    mod = obj.modifiers.get(MODIFIER)
+    if mod is not None and mod.type == "NODES":
+        _remove_helpers(mod)
+        obj.modifiers.remove(mod)
+    mesh = obj.data
+    if mesh is not None and getattr(mesh, "library", None) is None:
+        for name in (COORDINATES, FIN_INDEX):
+            attribute = mesh.attributes.get(name)
+            if attribute is not None:
+                mesh.attributes.remove(attribute)
+
+
+def write_frame(obj, table, fin_offsets):
+    """The frame's table (float32 (8 * 1024, 3)) and fin offsets (float32 (M, 3) or None)
+    into the helpers; tags them so Blender re-evaluates the modifier."""
+    table_mesh, fins_mesh = helpers(obj)
+    if table_mesh is None:
+        return False
+    rows = table.reshape(len(FIELDS), SEGMENTS * 3)
+    for k, name in enumerate(FIELDS):
+        table_mesh.attributes[name].data.foreach_set("vector", rows[k])
+    table_mesh.update_tag()
+    if fins_mesh is not None and fin_offsets is not None and len(fins_mesh.vertices) == len(fin_offsets):
+        fins_mesh.attributes[FIN_OFFSET].data.foreach_set("vector", fin_offsets.reshape(-1))
+        fins_mesh.update_tag()
+    return True
