@@ -92,7 +92,7 @@ def test_a_fish_bake_failing_midway_is_undone(empty_scene, tmp_path, monkeypatch
     obj = _fish(tmp_path)
     empty_scene.frame_set(5)
     modifiers = [m.name for m in obj.modifiers]
-    calls = _fails_on_the_third_call(monkeypatch, runtime, "evaluate")
+    calls = _fails_on_the_third_call(monkeypatch, runtime, "positions")
     _refused_cleanly(
         bpy.ops.kodawari.swim_bake, frame_start=1, frame_end=20, filepath=str(tmp_path / "f.pc2")
     )

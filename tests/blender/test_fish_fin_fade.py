@@ -4,7 +4,7 @@ welded fish, no mesh edge stretches past 1.5x at any frame, for every fin motion
 import bpy
 import numpy as np
 import pytest
-from fish_helpers import activate, frames, group_mask, set_fps, smooth_fish
+from fish_helpers import activate, frames, group_mask, rest, set_fps, smooth_fish
 
 MOTIONS = ("FLAP", "UP_DOWN", "TWIST", "UNDULATE")
 # Strong but ordinary settings: the panel's soft maximum is 1.5 rad; 0.6 rad is a big beat.
@@ -49,8 +49,7 @@ def test_no_edge_stretches_past_one_and_a_half_for_any_fin_motion(empty_scene, f
     assert bpy.ops.kodawari.swim_fin_find() == {"FINISHED"}
     settings = obj.kodawari_swim
     assert len(settings.fins) >= 3
-    co = np.empty((len(obj.data.vertices), 3), dtype=np.float32)
-    obj.data.shape_keys.reference_key.data.foreach_get("co", co.reshape(-1))
+    co = rest(obj)
     edges = _edges(obj)
     masks = {fin.vertex_group: group_mask(obj, fin.vertex_group) for fin in settings.fins}
     for fin in settings.fins:

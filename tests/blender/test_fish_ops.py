@@ -6,7 +6,6 @@ import bpy
 import numpy as np
 import pytest
 from fish_helpers import (
-    SHAPE_KEY,
     add_swim,
     body_length,
     evaluated,
@@ -89,7 +88,9 @@ def test_pc2_file_layout(empty_scene, tmp_path):
         header[12:], dtype=[("v", "<i4"), ("n", "<i4"), ("s", "<f4"), ("r", "<f4"), ("k", "<i4")]
     )[0]
     assert (version, points, start, rate, samples) == (1, len(obj.data.vertices), 5.0, 1.0, 4)
-    assert np.array_equal(data.reshape(4, points, 3), live_frames)
+    # The bake computes in the core what the Fish Swim modifier computes in Blender's nodes
+    # (docs/algorithms.md §1.6): the same shape up to float rounding.
+    assert np.abs(data.reshape(4, points, 3) - live_frames).max() < 1e-5 * body_length(obj)
 
 
 def test_settings_survive_save_and_reload(empty_scene, tmp_path):
@@ -131,12 +132,13 @@ def test_undo_after_swim_add_restores_the_mesh(empty_scene):
     assert "UNDO" in bpy.types.KODAWARI_OT_swim_add.bl_options
     bpy.ops.ed.undo_push(message="before swim")
     add_swim(obj, head_axis="AUTO")
-    assert bpy.data.objects["tuna"].data.shape_keys is not None
+    assert bpy.data.objects["tuna"].modifiers.get("Fish Swim") is not None
     # With a window, Blender pushes this step itself after an UNDO operator; headless, the test does.
     bpy.ops.ed.undo_push(message="Add Fish Swim")
     bpy.ops.ed.undo()
     obj = bpy.data.objects["tuna"]
-    assert obj.data.shape_keys is None
+    assert obj.data.shape_keys is None and len(obj.modifiers) == 0
+    assert not [a.name for a in obj.data.attributes if "kodawari" in a.name]
     assert not obj.kodawari_swim.enabled
     assert np.array_equal(rest(obj), original)
     bpy.context.scene.frame_set(5)  # the handler copes with the undone object
@@ -243,12 +245,13 @@ def test_shape_key_memory_write_matches_what_blender_reads(empty_scene):
     from kodawari import bulk
 
     obj = make_fish("tuna")
-    add_swim(obj, head_axis="POS_X")
-    block = obj.data.shape_keys.key_blocks[SHAPE_KEY]
+    obj.shape_key_add(name="Basis", from_mix=False)
+    block = obj.shape_key_add(name="Swim", from_mix=False)
+    block.value = 1.0
     positions = rest(obj) + np.random.default_rng(1).normal(size=rest(obj).shape).astype(np.float32)
     # The raw memory path is taken exactly where RNA lacks a fast one (before 4.1).
     assert bulk.write_shape_key_positions(block, positions) == (bpy.app.version < (4, 1, 0))
-    assert np.array_equal(live(obj), positions)
+    assert np.array_equal(bulk.shape_key_positions(block), positions)
     assert np.abs(evaluated(obj) - positions).max() < 1e-6
 
 
@@ -294,7 +297,6 @@ def test_user_shape_keys_added_later_apply_on_top(empty_scene):
     smile.data.foreach_set("co", (rest(obj) + offsets).reshape(-1))
     smile.value = 1.0
     bpy.context.scene.frame_set(4)
-    assert obj.data.shape_keys.key_blocks[1].name == SHAPE_KEY  # first after the Basis
     assert np.abs(evaluated(obj) - (swim + offsets)).max() < 1e-5
 
 

@@ -35,6 +35,7 @@ PROPERTIES = (
 HANDLERS = (
     ("frame_change_post", handlers.on_frame_change),
     ("load_post", handlers.on_load),
+    ("depsgraph_update_post", handlers.on_depsgraph_update),
     ("render_init", handlers.on_render_init),
     ("render_pre", handlers.on_render_pre),
     ("render_complete", handlers.on_render_done),

@@ -50,11 +50,9 @@ def _refusal(obj):
     if not runtime.has_swim(obj):
         return tip_("'{}' has no Fish Swim to apply").format(obj.name)
     keys = obj.data.shape_keys
-    others = [
-        b.name
-        for b in (keys.key_blocks if keys is not None else ())
-        if b.name != runtime.SHAPE_KEY and b != keys.reference_key
-    ]
+    # An older file's swim key and the Basis added with it are the swim's own.
+    ours = {runtime.SHAPE_KEY, keys.reference_key.name} if runtime.swim_key_block(obj) else set()
+    others = [b.name for b in (keys.key_blocks if keys is not None else ()) if b.name not in ours]
     if others:
         return tip_(
             "Cannot apply to a mesh with other shape keys ({}): apply or remove them first, "

@@ -73,7 +73,7 @@ class SwimBakeJob(BakeJob):
                 tip_("'{}' is already baked: Free Bake first to bake again").format(obj.name)
             )
         # Every binding input checked before a frame is baked (a deleted fin group fails here).
-        runtime.get_rig(obj)
+        runtime.get_rig(obj, check_rest=True)
         if obj.kodawari_swim.speed_mode != "NONE":
             self.follow = runtime.path.follow_path(obj)
         if self.target == "MESH_CACHE":
@@ -91,7 +91,7 @@ class SwimBakeJob(BakeJob):
         frame = self.frames[self.index]
         self.stepped = True
         self.scene.frame_set(frame)
-        positions = runtime.positions(self.obj, self.scene, frame)
+        positions = runtime.positions(self.obj, self.scene, frame, check_rest=False)
         if self.handle is not None:
             self.handle.write(np.ascontiguousarray(positions, dtype="<f4").tobytes())
         else:

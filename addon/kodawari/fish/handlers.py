@@ -8,17 +8,47 @@ from .. import problems
 from . import runtime, visibility
 
 
+_edited = set()  # meshes whose geometry changed since the last frame (depsgraph updates)
+
+
+def _collect_meshes(depsgraph, into):
+    for update in depsgraph.updates:
+        if update.is_updated_geometry and isinstance(update.id, bpy.types.Mesh):
+            into.add(update.id.original.as_pointer())
+
+
+@persistent
+def on_depsgraph_update(scene, depsgraph=None):
+    # Operators (Apply Scale, leaving Edit Mode) report their edits here, not to the
+    # frame handler.
+    if depsgraph is not None:
+        _collect_meshes(depsgraph, _edited)
+
+
+def _changed_meshes(depsgraph):
+    """Meshes whose geometry changed since the last frame (edited, Apply Scale, Edit Mode
+    left): only their rest shape is compared with the bound one (a full read)."""
+    if depsgraph is None:
+        return None  # unknown: compare every swimmer's
+    changed = set(_edited)
+    _edited.clear()
+    _collect_meshes(depsgraph, changed)
+    return changed
+
+
 @persistent
 def on_frame_change(scene, depsgraph=None):
     runtime.separate_linked_duplicates(scene)
+    changed = _changed_meshes(depsgraph)
     for obj in scene.objects:
         if obj.type != "MESH":
             continue
         visibility.pull(obj)  # a click on the Fish Swim modifier's own eye or camera
         if not runtime.is_live(obj):
             continue
+        check = changed is None or obj.data.as_pointer() in changed
         try:
-            runtime.evaluate(obj, scene)
+            runtime.evaluate(obj, scene, check_rest=check)
         except Exception as exc:  # noqa: BLE001 - one broken fish never stops the others
             problems.report(obj, "swim", exc)
         else:

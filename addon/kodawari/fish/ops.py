@@ -188,7 +188,7 @@ def _check_fin(obj, group_name, kind, known_weights=None, reach=None):
         vertex_group=group_name, kind=kind, motion=motion, root_blend=0.35
     )
     try:
-        rig = runtime.body_rig(obj)
+        rig = runtime.body_rig(obj, check_rest=True)
         kn = native.module()
         if reach is None:
             in_fin = weights > 0
@@ -315,7 +315,7 @@ class KODAWARI_OT_swim_fin_find(bpy.types.Operator):
         if error:
             self.report({"ERROR"}, error)
             return None
-        return finder.FinSearch(obj, runtime.get_rig(obj))
+        return finder.FinSearch(obj, runtime.get_rig(obj, check_rest=True))
 
     def _finish(self, context):
         obj = _active_mesh(context)
@@ -338,7 +338,7 @@ class KODAWARI_OT_swim_fin_find(bpy.types.Operator):
             known[name][indices] = 1.0
         # The groups' weights are known: bind once at the end, never re-read per vertex;
         # every fin's reach across itself comes from one pass over all of them.
-        rig = runtime.body_rig(obj)
+        rig = runtime.body_rig(obj, check_rest=True)
         in_fin = np.zeros(count, dtype=bool)
         for weights in known.values():
             in_fin |= weights > 0

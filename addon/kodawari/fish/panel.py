@@ -6,7 +6,7 @@ import bpy
 from bpy.app.translations import pgettext_iface as iface_
 
 from .. import in_use, problems
-from . import overlay, visibility
+from . import overlay, route, visibility
 
 MODIFIER_ICONS = {
     "ARMATURE": "MOD_ARMATURE",
@@ -210,9 +210,14 @@ class KODAWARI_PT_swim_order(_SwimPanel, bpy.types.Panel):
 
     def draw(self, context):
         col = self.layout.column(align=True)
-        col.label(text=iface_("1. Fish Swim (shape key)"), icon="MOD_WAVE", translate=False)
-        for index, modifier in enumerate(context.object.modifiers, start=2):
-            icon = MODIFIER_ICONS.get(modifier.type, "MODIFIER")
+        obj = context.object
+        first = 1
+        if route.modifier(obj) is None:  # an older file: the swim is still its shape key
+            col.label(text=iface_("1. Fish Swim (shape key)"), icon="MOD_WAVE", translate=False)
+            first = 2
+        swim = route.modifier(obj)
+        for index, modifier in enumerate(obj.modifiers, start=first):
+            icon = "MOD_WAVE" if modifier == swim else MODIFIER_ICONS.get(modifier.type, "MODIFIER")
             col.label(text=f"{index}. {modifier.name}", icon=icon, translate=False)
 
 

@@ -5,6 +5,8 @@ into a preallocated array (native, GIL released), each fin's axis motion and
 deform on its own vertices, carried by the body's rotation at the fin root.
 """
 
+import hashlib
+
 import numpy as np
 
 from .. import bulk, native
@@ -27,24 +29,19 @@ def rest_positions(obj):
     return bulk.vertex_positions(mesh)
 
 
-FINGERPRINT_SAMPLES = 32
 ROWING_KINDS = fin_setup.ROWING_KINDS
 
 
+def positions_digest(positions):
+    """A digest of float32 (N, 3) rest positions: equal digests, same rest shape."""
+    return hashlib.blake2b(np.ascontiguousarray(positions).data, digest_size=16).digest()
+
+
 def rest_fingerprint(obj):
-    """A cheap check (about 40 attribute reads, whatever the vertex count) that the rest
-    shape is the one the rig was bound to: where the rest positions live in memory
-    (leaving Edit Mode rewrites them) and a few of them spread over the mesh (Apply
-    Scale moves them all in place)."""
-    mesh = obj.data
-    keys = mesh.shape_keys
-    data = keys.reference_key.data if keys is not None and keys.reference_key else mesh.vertices
-    n = len(data)
-    if n == 0:
-        return (0,)
-    step = max(1, n // FINGERPRINT_SAMPLES)
-    sample = tuple(tuple(data[i].co) for i in range(0, n, step))
-    return (data[0].as_pointer(), sample)
+    """The digest of the rest shape as it is now (reads every rest position once: call it
+    when the mesh may have changed, never per frame; reading a mesh's positions through
+    Python makes Blender give the original mesh its own copy of them, 12 bytes per vertex)."""
+    return positions_digest(rest_positions(obj))
 
 
 def binding_signature(obj, settings):
@@ -62,7 +59,6 @@ class SwimRig:
         kn = native.module()
         self.kn = kn
         self.signature = binding_signature(obj, settings)
-        self.fingerprint = rest_fingerprint(obj)
         self.mesh_pointer = obj.data.as_pointer()
         # The rest shape and the deformed positions are not kept: the binding holds what a
         # frame needs, and a frame deforms straight into the shape key (runtime.evaluate).
@@ -70,6 +66,7 @@ class SwimRig:
         self.owner = obj  # refreshed by runtime.get_rig/body_rig before every use
         self.positions = None  # allocated only for a caller without an `out`
         rest = rest_positions(obj)
+        self.fingerprint = positions_digest(rest)
         self.count = len(rest)
         self.head, self.up, self.side = midline.body_frame(settings.head_axis)
         self.axis_rest, self.body_length = midline.midline_points(
@@ -177,6 +174,12 @@ class SwimRig:
     def packed_coordinates(self):
         """float32 (N, 3): each vertex's (s, u, v), the route's bound attribute."""
         return self.binding.packed_coordinates(self.end_scale)
+
+    def rest_table(self):
+        """The frame table of the rest axis (the route's rest shape, for shape-key offsets)."""
+        table = np.empty_like(self.table)
+        self.binding.frame_table(self.axis_rest, table)
+        return table
 
     def frame(self, settings, phase, rest_axis=None):
         """What the route needs for one frame: the frame table (float32 (8 * 1024, 3)) and

@@ -26,6 +26,7 @@ FIN_INDEX = ".kodawari_swim_fin"  # int per vertex: its row in the fin helper, -
 FIN_OFFSET = "offset"
 SEGMENTS = 1024
 FIELDS = ("o", "do", "e1", "de1", "e2", "de2", "e3", "de3")  # rows of AxisBinding.frame_table
+REST = "rest_"  # the rest table's fields, read only when the mesh has shape keys
 
 
 def modifier(obj):
@@ -112,7 +113,7 @@ class _Tree:
         return info.outputs["Geometry"]
 
 
-def build_group(table_obj, fins_obj, end_scale):
+def build_group(table_obj, fins_obj, end_scale, with_keys=False):
     """P' = (O + u e2 + v e3 + w e1) + f (dO + u de2 + v de3 + w de1) [+ fin offset], the
     core's deform_vertex (docs/algorithms.md §1.4, §1.6) in nodes."""
     group = bpy.data.node_groups.new(GROUP, "GeometryNodeTree")
@@ -133,14 +134,30 @@ def build_group(table_obj, fins_obj, end_scale):
     w = tree.math("MULTIPLY", tree.math("SUBTRACT", s, t), 1.0 / end_scale)
     segment = tree.math("MINIMUM", tree.math("FLOOR", t, 0.0), float(SEGMENTS - 1))
     fraction = tree.math("SUBTRACT", t, segment)
-    row = {name: tree.sample(table, name, segment) for name in FIELDS}
-    at = tree.multiply_add(row["e2"], u, row["o"])
-    at = tree.multiply_add(row["e3"], v, at)
-    at = tree.multiply_add(row["e1"], w, at)
-    change = tree.multiply_add(row["de2"], u, row["do"])
-    change = tree.multiply_add(row["de3"], v, change)
-    change = tree.multiply_add(row["de1"], w, change)
-    moved = tree.multiply_add(change, fraction, at)
+
+    def bend(prefix):
+        row = {name: tree.sample(table, prefix + name, segment) for name in FIELDS}
+        at = tree.multiply_add(row["e2"], u, row["o"])
+        at = tree.multiply_add(row["e3"], v, at)
+        at = tree.multiply_add(row["e1"], w, at)
+        change = tree.multiply_add(row["de2"], u, row["do"])
+        change = tree.multiply_add(row["de3"], v, change)
+        change = tree.multiply_add(row["de1"], w, change)
+        return tree.multiply_add(change, fraction, at)
+
+    moved = bend("")
+    if with_keys:
+        # The user's shape keys move the mesh before the swim: their offset from the rest
+        # shape (the bound rest table gives it back) rides on the bent body, as a relative
+        # key on top of the swim did.
+        position = tree.node("GeometryNodeInputPosition").outputs[0]
+        offset = tree.node("ShaderNodeVectorMath", operation="SUBTRACT")
+        tree.links.new(position, offset.inputs[0])
+        tree.links.new(bend(REST), offset.inputs[1])
+        add = tree.node("ShaderNodeVectorMath", operation="ADD")
+        tree.links.new(moved, add.inputs[0])
+        tree.links.new(offset.outputs[0], add.inputs[1])
+        moved = add.outputs[0]
     if fins_obj is not None:
         # Off the fins the index is -1: Sample Index gives a zero offset out of range.
         offset = tree.sample(
@@ -216,7 +233,11 @@ def install(obj, rig, show_viewport=True, show_render=True):
     else:
         mod = obj.modifiers.new(MODIFIER, "NODES")
     _write_attribute(mesh, COORDINATES, "FLOAT_VECTOR", rig.packed_coordinates())
-    table_obj = _helper_object(TABLE, SEGMENTS, FIELDS)
+    with_keys = mesh.shape_keys is not None
+    table_obj = _helper_object(TABLE, SEGMENTS, FIELDS + tuple(REST + f for f in FIELDS))
+    rest_rows = rig.rest_table().reshape(len(FIELDS), SEGMENTS * 3)
+    for k, name in enumerate(FIELDS):
+        table_obj.data.attributes[REST + name].data.foreach_set("vector", rest_rows[k])
     fins_obj = None
     if rig.fin_vertices is not None:
         index = np.full(len(mesh.vertices), -1, np.int32)
@@ -225,7 +246,8 @@ def install(obj, rig, show_viewport=True, show_render=True):
         fins_obj = _helper_object(FINS, len(rig.fin_vertices), (FIN_OFFSET,))
     elif mesh.attributes.get(FIN_INDEX) is not None:
         mesh.attributes.remove(mesh.attributes[FIN_INDEX])
-    mod.node_group = build_group(table_obj, fins_obj, rig.end_scale)
+    mod.node_group = build_group(table_obj, fins_obj, rig.end_scale, with_keys)
+    mod.node_group["kodawari_with_keys"] = with_keys
     # In Edit Mode the user edits the rest shape: show it, as the shape key used to.
     mod.show_in_editmode = False
     mod.show_viewport, mod.show_render = show_viewport, show_render
@@ -239,9 +261,12 @@ def installed_for(obj, rig):
     mod = modifier(obj)
     if mod is None or getattr(rig, "installed_on", None) != obj.data.as_pointer():
         return False
-    attribute = obj.data.attributes.get(COORDINATES)
-    return attribute is not None and (rig.fin_vertices is None) == (
-        obj.data.attributes.get(FIN_INDEX) is None
+    mesh = obj.data
+    return (
+        mesh.attributes.get(COORDINATES) is not None
+        and (rig.fin_vertices is None) == (mesh.attributes.get(FIN_INDEX) is None)
+        # shape keys added or removed since: the tree reads their offset, or not
+        and bool(mod.node_group.get("kodawari_with_keys")) == (mesh.shape_keys is not None)
     )
 
 

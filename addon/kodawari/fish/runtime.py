@@ -35,14 +35,17 @@ def forget(obj=None):
         _rigs.pop(_key(obj), None)
 
 
-def get_rig(obj, build=True, known_weights=None):
-    """The object's bound rig, rebuilt when its binding inputs changed."""
+def get_rig(obj, build=True, known_weights=None, check_rest=False):
+    """The object's bound rig, rebuilt when its binding inputs changed. check_rest: also
+    compare the rest shape with the bound one (reads every rest position: after edits
+    such as Edit Mode or Apply Scale; the frame handler asks when Blender saw the mesh
+    change, operators that set up from the rest shape always)."""
     settings = obj.kodawari_swim
     rig = _rigs.get(_key(obj))
     if rig is not None and (
         rig.signature != rig_module.binding_signature(obj, settings)
         or rig.mesh_pointer != obj.data.as_pointer()
-        or rig.fingerprint != rig_module.rest_fingerprint(obj)  # Apply Scale, Edit-Mode edits
+        or (check_rest and rig.fingerprint != rig_module.rest_fingerprint(obj))
     ):
         rig = None
     if rig is None and build:
@@ -54,25 +57,24 @@ def get_rig(obj, build=True, known_weights=None):
 
 
 def adopt(obj, rig):
-    """Keep a rig bound for obj just before its shape keys were added (Add Fish Swim's trial
-    bind) instead of binding the mesh again: same rest shape and settings, so only where the
-    rest positions now live (the Basis key) is refreshed. A rig bound with other settings
-    is dropped and get_rig binds again."""
+    """Keep a rig bound for obj on trial (Add Fish Swim) instead of binding the mesh again:
+    same rest shape and settings. A rig bound with other settings is dropped and get_rig
+    binds again."""
     if rig.signature != rig_module.binding_signature(obj, obj.kodawari_swim):
         return
-    rig.fingerprint = rig_module.rest_fingerprint(obj)
     rig.mesh_pointer = obj.data.as_pointer()
     rig.owner = obj
     _rigs[_key(obj)] = rig
 
 
-def body_rig(obj):
+def body_rig(obj, check_rest=False):
     """A rig whose rest shape and body axis are current (its fins may be out of date):
     what checking a new fin needs, without rebinding every fin."""
     rig = _rigs.get(_key(obj))
     if rig is not None and (
         rig.signature[:3] != rig_module.binding_signature(obj, obj.kodawari_swim)[:3]
         or rig.mesh_pointer != obj.data.as_pointer()
+        or (check_rest and rig.fingerprint != rig_module.rest_fingerprint(obj))
     ):
         rig = None
     if rig is None:
@@ -149,11 +151,11 @@ def apply_travel(obj, rig, distance):
     obj.delta_location = rest + travel_direction(obj, rig) * distance
 
 
-def _pose(obj, scene, frame):
+def _pose(obj, scene, frame, check_rest):
     """(rig, settings, phase, rest axis or None) for a frame, the object placed on its
     travel or path."""
     settings = obj.kodawari_swim
-    rig = get_rig(obj)
+    rig = get_rig(obj, check_rest=check_rest)
     if frame is None:
         frame = scene.frame_current + scene.frame_subframe
     phase, distance = timing.phase_and_distance(obj, settings, scene, frame, rig.body_length)
@@ -173,20 +175,21 @@ def _pose(obj, scene, frame):
     return rig, settings, phase, rest_axis
 
 
-def evaluate(obj, scene, frame=None):
+def evaluate(obj, scene, frame=None, check_rest=False):
     """Pose one object for a frame (the scene's current frame by default): its frame table
     and fin offsets go into the Fish Swim modifier's helpers, and Blender bends the mesh
-    when it evaluates it (route.py). Installs the route when the binding changed."""
-    rig, settings, phase, rest_axis = _pose(obj, scene, frame)
+    when it evaluates it (route.py). Installs the route when the binding changed;
+    check_rest: see get_rig."""
+    rig, settings, phase, rest_axis = _pose(obj, scene, frame, check_rest)
     ensure_route(obj, rig)
     table, fin_offsets = rig.frame(settings, phase, rest_axis)
     route.write_frame(obj, table, fin_offsets)
 
 
-def positions(obj, scene, frame=None):
+def positions(obj, scene, frame=None, check_rest=True):
     """The shape the modifier gives at a frame, as float32 (N, 3) positions computed by the
     core (bake, apply): the rig's buffer, copy it to keep it."""
-    rig, settings, phase, rest_axis = _pose(obj, scene, frame)
+    rig, settings, phase, rest_axis = _pose(obj, scene, frame, check_rest)
     return rig.evaluate(settings, phase, rest_axis)
 
 
