@@ -129,7 +129,40 @@ void bind_ffd(py::module_& m) {
           },
           py::arg("end_scale"),
           "float32 (N, 3): (s, u, v) per vertex, s = segment + fraction, or beyond an end w * end_scale "
-          "(head) / 1024 + w * end_scale (tail).");
+          "(head) / 1024 + w * end_scale (tail).")
+      .def("release_coordinates", &AxisBinding::release_coordinates,
+           "Free the per-vertex coordinates (kept in a packed attribute instead); frame_table still works.")
+      .def_property_readonly("released", &AxisBinding::released);
+
+  m.def(
+      "ffd_deform_packed",
+      [](const py::handle& table, const py::handle& packed, double end_scale, const py::handle& out) {
+        if (!(end_scale > 0) || !std::isfinite(end_scale)) throw py::value_error("end_scale must be > 0");
+        const auto rows = checked_array<float>(table, "table", 8 * ffd::kTableSegments, 3);
+        const auto coordinates = checked_array<float>(packed, "packed", -1, 3);
+        const py::ssize_t n = coordinates.shape(0);
+        auto target = checked_output<float>(out, "out", n, 3);
+        no_overlap(target, "out", coordinates, "packed");
+        ffd::FrameTable frame_table(ffd::kTableSegments);
+        const float* data = rows.data();
+        for (std::size_t i = 0; i < frame_table.size(); ++i) {
+          ffd::TableSegment& s = frame_table[i];
+          ffd::Vec4f* fields[8] = {&s.origin, &s.d_origin, &s.e1, &s.d_e1, &s.e2, &s.d_e2, &s.e3, &s.d_e3};
+          for (std::size_t f = 0; f < 8; ++f) {
+            const float* v = data + 3 * (f * frame_table.size() + i);
+            *fields[f] = ffd::Vec4f(v[0], v[1], v[2], 0.0f);
+          }
+        }
+        float* result = target.mutable_data();
+        const float* source = coordinates.data();
+        {
+          py::gil_scoped_release release;
+          ffd::deform_packed(frame_table, source, static_cast<std::size_t>(n), static_cast<float>(end_scale), result);
+        }
+      },
+      py::arg("table"), py::arg("packed"), py::arg("end_scale"), py::arg("out"),
+      "Deform packed (s, u, v) coordinates (float32 (N, 3)) by a frame table (float32 (8 * 1024, 3), "
+      "AxisBinding.frame_table) into out (float32 (N, 3)): what the Fish Swim modifier computes.");
 
   m.def(
       "ffd_bind",

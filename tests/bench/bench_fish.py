@@ -5,7 +5,10 @@ For a smooth fish-shaped quad body of 100 k, 1 M and 4 M vertices, each side get
 per-frame treatment a viewport gives it: `scene.frame_set(f)`, then the depsgraph evaluates
 whatever is tagged, then the evaluated mesh's vertex normals are read (a viewport draws them).
 
-  kodawari        the add-on's live swim (frame handler -> native FFD -> shape key write)
+  kodawari        the add-on's live swim: the frame handler writes the frame table (1024
+                  segments) into the Fish Swim modifier's helper; Blender's evaluation bends
+                  the mesh in that Geometry Nodes modifier from the bound (s, u, v) attribute
+                  (docs/algorithms.md §1.6)
   geometry_nodes  a Geometry Nodes bend of the same mesh along the same animated curve:
                   Sample Curve (factor = position along the body) -> Set Position
                   (curve point + normal * y + binormal * z), built here through the node API
@@ -315,7 +318,8 @@ def child(spec):
 
 def solver_alone(obj, scene, frames):
     """The add-on's own per-frame work without Blender's evaluation: runtime.evaluate
-    (phase, native FFD deform, shape key write) and the native deform alone."""
+    (phase, body axis, frame table, helper write), and the core's whole-mesh deform alone
+    (what a bake or Apply computes per frame, not the live path)."""
     from kodawari.fish import runtime
 
     rig = runtime.get_rig(obj)

@@ -15,7 +15,7 @@ from bpy.app.translations import pgettext_tip as tip_
 
 from .. import cache_paths, editable, fcurves
 from ..bake_job import BakeError, BakeJob
-from . import runtime, visibility
+from . import route, runtime, visibility
 
 CACHE_MODIFIER = "Kodawari Swim Cache"
 BAKED_KEY_PREFIX = "Kodawari Swim "
@@ -144,8 +144,7 @@ class SwimBakeJob(BakeJob):
             modifier.frame_scale = 1.0
             modifier.deform_mode = "OVERWRITE"
             modifier.interpolation = "LINEAR"
-            if hasattr(obj.modifiers, "move"):
-                obj.modifiers.move(list(obj.modifiers).index(modifier), 0)
+            route.move_first(obj, modifier)
             settings.cache_path = modifier.filepath
         else:
             if obj.data.shape_keys is None:

@@ -11,7 +11,7 @@ import numpy as np
 
 from .. import bulk, native
 from . import fins as fin_setup
-from . import midline
+from . import midline, route
 
 SHAPE_KEY = "Kodawari Swim"  # the swim's shape key before the node route (kept for old files)
 TABLE_SEGMENTS = 1024  # the core's frame table (native/include/kodawari/ffd/frame_table.hpp)
@@ -172,8 +172,18 @@ class SwimRig:
         return TABLE_SEGMENTS / max(float(self.body_length), 1e-12)
 
     def packed_coordinates(self):
-        """float32 (N, 3): each vertex's (s, u, v), the route's bound attribute."""
-        return self.binding.packed_coordinates(self.end_scale)
+        """float32 (N, 3): each vertex's (s, u, v), the route's bound attribute (read back
+        from the mesh once the binding released its own copy)."""
+        if not self.binding.released:
+            return self.binding.packed_coordinates(self.end_scale)
+        out = np.empty((self.count, 3), dtype=np.float32)
+        self.owner.data.attributes[route.COORDINATES].data.foreach_get("vector", out.reshape(-1))
+        return out
+
+    def release_coordinates(self):
+        """The packed attribute holds the binding now: free the core's per-vertex copy (20
+        bytes per vertex; issue 13 item 4). Bake and Apply read the attribute instead."""
+        self.binding.release_coordinates()
 
     def rest_table(self):
         """The frame table of the rest axis (the route's rest shape, for shape-key offsets)."""
@@ -204,7 +214,12 @@ class SwimRig:
             out = self.positions
         positions = out
         self.axis = self.body_axis(settings, phase, rest_axis)
-        self.binding.deform(self.axis, positions)
+        if self.binding.released:
+            # What the modifier computes, in the core (docs/algorithms.md §1.6).
+            self.binding.frame_table(self.axis, self.table)
+            self.kn.ffd_deform_packed(self.table, self.packed_coordinates(), self.end_scale, positions)
+        else:
+            self.binding.deform(self.axis, positions)
         if not self.parts:
             return positions
         for part in self._moving_parts(settings, phase):

@@ -185,7 +185,8 @@ def _helper_object(name, count, attributes):
     return bpy.data.objects.new(name, mesh)  # in no collection: not in the scene's Outliner
 
 
-def _move_first(obj, mod):
+def move_first(obj, mod):
+    """Put a modifier first in the object's stack (3.4 has no ObjectModifiers.move)."""
     index = list(obj.modifiers).index(mod)
     if index == 0:
         return
@@ -251,8 +252,9 @@ def install(obj, rig, show_viewport=True, show_render=True):
     # In Edit Mode the user edits the rest shape: show it, as the shape key used to.
     mod.show_in_editmode = False
     mod.show_viewport, mod.show_render = show_viewport, show_render
-    _move_first(obj, mod)
+    move_first(obj, mod)
     rig.installed_on = mesh.as_pointer()
+    rig.release_coordinates()  # the attribute holds them now
     return mod
 
 

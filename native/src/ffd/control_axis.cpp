@@ -158,9 +158,16 @@ AxisBinding::AxisBinding(const Vec3List& control_points, const float* vertices, 
   for (const AxisCoordinate& c : coordinates_) {
     reach_ = std::max({reach_, std::abs(c.u), std::abs(c.v), std::abs(c.w)});
   }
+  count_ = count;
+}
+
+void AxisBinding::release_coordinates() {
+  std::vector<AxisCoordinate>().swap(coordinates_);
+  released_ = true;
 }
 
 float AxisBinding::parameter(std::size_t i) const {
+  if (released_) throw std::logic_error("the binding's coordinates were released");
   const AxisCoordinate& c = coordinates_[i];
   return static_cast<float>((Real(c.segment) + Real(c.fraction)) / kTableSegments);
 }
@@ -186,6 +193,7 @@ void AxisBinding::frame_table(const Vec3List& control_points, const std::vector<
 }
 
 void AxisBinding::packed_coordinates(float end_scale, float* out) const {
+  if (released_) throw std::logic_error("the binding's coordinates were released");
   for (std::size_t i = 0; i < coordinates_.size(); ++i) {
     const AxisCoordinate& c = coordinates_[i];
     float s = static_cast<float>(c.segment) + c.fraction;
@@ -205,6 +213,7 @@ void AxisBinding::packed_coordinates(float end_scale, float* out) const {
 
 void AxisBinding::deform(const Vec3List& control_points, const std::vector<Real>& twist,
                          const std::optional<Vec3>& up, float* out, unsigned threads) const {
+  if (released_) throw std::logic_error("the binding's coordinates were released: deform the packed ones");
   FrameTable table;
   frame_table(control_points, twist, up, table);
 
@@ -212,6 +221,26 @@ void AxisBinding::deform(const Vec3List& control_points, const std::vector<Real>
   const TableSegment* segments = table.data();
   parallel_chunks(coordinates_.size(), threads, kDeformGrain, [&](std::size_t begin, std::size_t end) {
     for (std::size_t i = begin; i < end; ++i) deform_vertex(segments[coords[i].segment], coords[i], out + 3 * i);
+  });
+}
+
+void deform_packed(const FrameTable& table, const float* packed, std::size_t count, float end_scale, float* out,
+                   unsigned threads) {
+  const float inverse_scale = 1.0f / end_scale;
+  const float last = float(kTableSegments);
+  parallel_chunks(count, threads, kDeformGrain, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) {
+      const float s = packed[3 * i];
+      const float t = std::clamp(s, 0.0f, last);
+      const float segment = std::min(std::floor(t), last - 1.0f);
+      AxisCoordinate c;
+      c.segment = static_cast<std::uint32_t>(segment);
+      c.fraction = t - segment;
+      c.u = packed[3 * i + 1];
+      c.v = packed[3 * i + 2];
+      c.w = (s - t) * inverse_scale;
+      deform_vertex(table[c.segment], c, out + 3 * i);
+    }
   });
 }
 

@@ -30,7 +30,7 @@ class AxisBinding {
   AxisBinding(const Vec3List& control_points, const float* vertices, std::size_t count,
               const std::vector<Real>& twist, const std::optional<Vec3>& up, unsigned threads = 0);
 
-  std::size_t count() const { return coordinates_.size(); }
+  std::size_t count() const { return count_; }
   int control_point_count() const { return control_point_count_; }
   const std::vector<AxisCoordinate>& coordinates() const { return coordinates_; }
   float parameter(std::size_t i) const;  // t in [0, 1]
@@ -56,6 +56,12 @@ class AxisBinding {
   // kTableSegments + w * end_scale after the tail. Writes 3 * count() floats.
   void packed_coordinates(float end_scale, float* out) const;
 
+  // Frees the per-vertex coordinates (20 bytes per vertex) once they live elsewhere (the
+  // packed attribute of the Blender mesh): frame_table() still works; deform() and
+  // packed_coordinates() then throw std::logic_error (use deform_packed).
+  void release_coordinates();
+  bool released() const { return released_; }
+
  private:
   int control_point_count_ = 0;
   UniformCurveSampler sampler_;
@@ -63,6 +69,14 @@ class AxisBinding {
   Vec3 rest_normal_ = Vec3::UnitY();
   std::vector<AxisCoordinate> coordinates_;
   float reach_ = 0;  // the largest |u|, |v|, |w| bound: with the frame table it bounds |P'|
+  bool released_ = false;
+  std::size_t count_ = 0;
 };
+
+// deform() from packed coordinates (AxisBinding::packed_coordinates, the same end_scale)
+// and a frame table (AxisBinding::frame_table): `count` xyz triples into `out`, the same
+// arithmetic per vertex as deform() (docs/algorithms.md §1.6).
+void deform_packed(const FrameTable& table, const float* packed, std::size_t count, float end_scale, float* out,
+                   unsigned threads = 0);
 
 }  // namespace kodawari::ffd

@@ -1,0 +1,193 @@
+"""Fish Swim as a real Geometry Nodes modifier (issue 13 items 1, 4; docs/algorithms.md §1.6):
+what Blender shows equals what the core computes (bake, apply), on the sample fish and on a
+smooth high-poly fish with a mouth and found fins; the modifier behaves like one (first in
+the stack, its eye hides the swim, undo, save and reload); Remove Fish Swim leaves the mesh
+exactly as it was; the mesh carries one 12-byte attribute per vertex, no shape keys."""
+
+import bpy
+import numpy as np
+import pytest
+from fish_helpers import activate, add_swim, evaluated, make_fish, rest, set_fps, smooth_fish
+
+MODIFIER = "Fish Swim"
+
+
+def _route_equals_core(obj, frames):
+    from kodawari.fish import runtime
+
+    scene = bpy.context.scene
+    length = runtime.get_rig(obj).body_length
+    worst, moved = 0.0, 0.0
+    for frame in frames:
+        scene.frame_set(frame)
+        shown = evaluated(obj)
+        core = runtime.positions(obj, scene, frame).copy()
+        worst = max(worst, float(np.abs(shown - core).max()) / length)
+        moved = max(moved, float(np.abs(core - rest(obj)).max()) / length)
+    return worst, moved
+
+
+def _mesh_state(mesh):
+    keys = mesh.shape_keys
+    return {
+        "positions": rest_of(mesh).tobytes(),
+        "attributes": sorted((a.name, a.data_type, a.domain) for a in mesh.attributes),
+        "keys": [k.name for k in keys.key_blocks] if keys is not None else None,
+    }
+
+
+def rest_of(mesh):
+    out = np.empty((len(mesh.vertices), 3), dtype=np.float32)
+    mesh.vertices.foreach_get("co", out.reshape(-1))
+    return out
+
+
+def _data_counts():
+    return (len(bpy.data.objects), len(bpy.data.meshes), len(bpy.data.node_groups))
+
+
+@pytest.mark.parametrize("kind", ["tuna", "eel", "dolphin"])
+def test_the_modifier_shows_what_the_core_computes_on_the_sample_fish(empty_scene, kind):
+    set_fps(24)
+    obj = make_fish(kind)
+    groups = [g.name for g in obj.vertex_groups if g.name.startswith("fin_")]
+    add_swim(obj, fins=groups, head_axis="POS_X", frequency=2.0)
+    for fin in obj.kodawari_swim.fins:
+        fin.feathering = 0.4  # every motion term of the fins in play
+    worst, moved = _route_equals_core(obj, (2, 5, 9, 14))
+    assert moved > 0.02, "the fish swims"
+    assert worst < 1e-5, f"{kind}: the modifier is {worst:.2e} body lengths from the core"
+
+
+@pytest.mark.parametrize("form", ["spindle", "cetacean", "eel"])
+def test_the_modifier_shows_what_the_core_computes_on_a_smooth_fish_with_a_mouth(
+    empty_scene, form
+):
+    set_fps(24)
+    obj = smooth_fish.build_smooth_fish(form, subdivisions=2)
+    for group in list(obj.vertex_groups):
+        obj.vertex_groups.remove(group)  # the fins are found, as a user would
+    obj.scale = (0.01, 0.01, 0.01)  # a fish modelled in centimetres
+    activate(obj)
+    preset = "CETACEAN" if form == "cetacean" else "CARANGIFORM"
+    assert bpy.ops.kodawari.swim_add(preset=preset, frequency=2.0) == {"FINISHED"}
+    assert bpy.ops.kodawari.swim_fin_find() == {"FINISHED"}
+    assert len(obj.kodawari_swim.fins) >= 3
+    worst, moved = _route_equals_core(obj, (3, 8, 11))
+    assert moved > 0.02
+    assert worst < 1e-5, f"{form}: the modifier is {worst:.2e} body lengths from the core"
+
+
+def test_fish_swim_is_the_first_modifier_and_its_eye_hides_the_swim(empty_scene):
+    set_fps(24)
+    obj = make_fish("tuna")
+    original = rest(obj).copy()
+    add_swim(obj, head_axis="POS_X", frequency=2.0)
+    obj.modifiers.new("Displace", "DISPLACE").strength = 0.0  # the user's, added after
+    assert [m.name for m in obj.modifiers] == [MODIFIER, "Displace"]
+    assert obj.modifiers[0].type == "NODES"
+    scene = bpy.context.scene
+    scene.frame_set(4)
+    assert np.abs(evaluated(obj) - original).max() > 1e-3, "the fish swims"
+    obj.modifiers[MODIFIER].show_viewport = False  # the modifier's own eye
+    scene.frame_set(5)
+    assert np.abs(evaluated(obj) - original).max() < 1e-6, "hidden: the rest shape"
+    assert not obj.kodawari_swim.enabled, "the Fish Swim panel's eye follows the modifier's"
+    obj.kodawari_swim.enabled = True  # the panel's eye
+    assert obj.modifiers[MODIFIER].show_viewport
+    scene.frame_set(6)
+    assert np.abs(evaluated(obj) - original).max() > 1e-3, "shown again, it swims"
+
+
+def test_the_swim_survives_save_and_reload_with_its_helpers_out_of_the_scene(
+    empty_scene, tmp_path
+):
+    set_fps(24)
+    obj = make_fish("tuna")
+    add_swim(obj, fins=("fin_pectoral", "fin_caudal"), head_axis="POS_X", frequency=2.0)
+    scene = bpy.context.scene
+    scene.frame_set(7)
+    before = evaluated(obj)
+    path = str(tmp_path / "fish.blend")
+    bpy.ops.wm.save_as_mainfile(filepath=path)
+    bpy.ops.wm.read_homefile(use_empty=True, use_factory_startup=True)
+    bpy.ops.wm.open_mainfile(filepath=path)
+    obj = bpy.data.objects["tuna"]
+    scene = bpy.context.scene
+    assert obj.modifiers[0].name == MODIFIER and obj.modifiers[0].node_group is not None
+    # The helpers live in the file but in no collection: the scene's Outliner lists the fish only.
+    assert [o.name for o in scene.objects] == ["tuna"]
+    assert all(o.name.startswith(".") for o in bpy.data.objects if o is not obj)
+    assert evaluated(obj) == pytest.approx(before, abs=1e-6), "the opened file shows the swim"
+    scene.frame_set(3)
+    scene.frame_set(7)
+    assert np.abs(evaluated(obj) - before).max() < 1e-6, "and plays on as before"
+
+
+def test_remove_leaves_the_mesh_and_the_file_exactly_as_before(empty_scene):
+    set_fps(24)
+    obj = make_fish("dolphin")
+    before, counts = _mesh_state(obj.data), _data_counts()
+    add_swim(obj, fins=("fin_pectoral", "fin_caudal"), head_axis="POS_X", preset="CETACEAN")
+    bpy.context.scene.frame_set(9)
+    assert _data_counts() != counts
+    activate(obj)
+    assert bpy.ops.kodawari.swim_remove() == {"FINISHED"}
+    assert len(obj.modifiers) == 0
+    assert _mesh_state(obj.data) == before, "positions, attributes and keys as before"
+    assert _data_counts() == counts, "no node group, helper object or mesh left behind"
+
+
+def test_undo_of_remove_brings_the_modifier_back_swimming(empty_scene):
+    set_fps(24)
+    obj = make_fish("tuna")
+    add_swim(obj, fins=("fin_pectoral",), head_axis="POS_X", frequency=2.0)
+    scene = bpy.context.scene
+    scene.frame_set(5)
+    swimming = evaluated(obj)
+    bpy.ops.ed.undo_push(message="before remove")
+    assert bpy.ops.kodawari.swim_remove() == {"FINISHED"}
+    bpy.ops.ed.undo_push(message="Remove Fish Swim")
+    bpy.ops.ed.undo()
+    obj = bpy.data.objects["tuna"]
+    assert obj.modifiers[0].name == MODIFIER
+    scene = bpy.context.scene
+    scene.frame_set(4)
+    scene.frame_set(5)
+    assert np.abs(evaluated(obj) - swimming).max() < 1e-5
+
+
+def test_a_duplicate_swims_with_its_own_settings(empty_scene):
+    set_fps(24)
+    obj = make_fish("tuna")
+    add_swim(obj, head_axis="POS_X", frequency=2.0)
+    activate(obj)
+    bpy.ops.object.duplicate()  # Shift-D: the modifier's node group is shared at first
+    twin = bpy.context.active_object
+    assert twin is not obj
+    twin.kodawari_swim.frequency = 1.0
+    scene = bpy.context.scene
+    scene.frame_set(2)
+    scene.frame_set(4)
+    assert twin.modifiers[MODIFIER].node_group != obj.modifiers[MODIFIER].node_group
+    for fish in (obj, twin):
+        from kodawari.fish import runtime
+
+        core = runtime.positions(fish, scene, 4)
+        assert np.abs(evaluated(fish) - core).max() < 1e-5, fish.name
+    assert np.abs(evaluated(obj) - evaluated(twin)).max() > 1e-3, "each with its own frequency"
+
+
+def test_the_live_mesh_carries_one_small_attribute_and_no_shape_key(empty_scene):
+    # Memory (issue 13 item 4): per vertex the swim adds 12 bytes to the user's mesh (the
+    # packed (s, u, v)); no shape key (a Basis and a swim key: 24 bytes more per vertex).
+    set_fps(24)
+    obj = make_fish("tuna")
+    names = {a.name for a in obj.data.attributes}
+    add_swim(obj, head_axis="POS_X", frequency=2.0)
+    bpy.context.scene.frame_set(3)
+    added = [
+        (a.name, a.data_type, a.domain) for a in obj.data.attributes if a.name not in names
+    ]
+    assert added == [(".kodawari_swim_ffd", "FLOAT_VECTOR", "POINT")]
+    assert obj.data.shape_keys is None
