@@ -160,3 +160,34 @@ TEST(FfdControlAxis, BadInputThrowsNamingTheArgument) {
   EXPECT_NE(message([&] { binding.deform(fixtures::straight_axis(5), {}, std::nullopt, out.data()); }).find("control_points"),
             std::string::npos);
 }
+
+// docs/algorithms.md §1.6: what the Fish Swim modifier computes from the packed (s, u, v)
+// attribute and the frame table equals deform(), caps past both ends included (their w
+// rides in s outside [0, 1024]), and a released binding still gives the frame table.
+TEST(FfdControlAxis, PackedCoordinatesAndTheFrameTableGiveDeformsPositions) {
+  const Vec3List rest = fixtures::s_curve(16);
+  const std::size_t count = 20000;
+  const std::vector<float> mesh = tube_around(rest, count);
+  AxisBinding binding(rest, mesh.data(), count, {}, std::nullopt);
+  Vec3List bent = rest;
+  for (std::size_t i = 0; i < bent.size(); ++i) bent[i] += Vec3(0, 0.3 * std::sin(0.7 * Real(i)), 0.1 * Real(i) / 16);
+  std::vector<float> expected(3 * count);
+  binding.deform(bent, {}, std::nullopt, expected.data());
+
+  const float length = static_cast<float>(curve_length(CubicBSpline(rest)));
+  const float end_scale = float(kTableSegments) / length;
+  std::vector<float> packed(3 * count);
+  binding.packed_coordinates(end_scale, packed.data());
+  std::size_t beyond = 0;
+  for (std::size_t i = 0; i < count; ++i) beyond += packed[3 * i] < 0 || packed[3 * i] > float(kTableSegments);
+  EXPECT_GT(beyond, 10u);  // caps past the ends are among them
+
+  binding.release_coordinates();
+  EXPECT_EQ(binding.count(), count);
+  EXPECT_THROW(binding.deform(bent, {}, std::nullopt, expected.data()), std::logic_error);
+  FrameTable table;
+  binding.frame_table(bent, {}, std::nullopt, table);
+  std::vector<float> out(3 * count);
+  deform_packed(table, packed.data(), count, end_scale, out.data());
+  EXPECT_LT(max_distance(out, expected), 1e-5 * length);
+}
