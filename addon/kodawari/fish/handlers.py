@@ -47,6 +47,8 @@ def on_frame_change(scene, depsgraph=None):
         if not runtime.is_live(obj):
             continue
         check = changed is None or obj.data.as_pointer() in changed
+        if check and changed is not None and runtime.consume_own_update(obj):
+            check = False  # the change Blender reports is the route's own attributes
         try:
             runtime.evaluate(obj, scene, check_rest=check)
         except Exception as exc:  # noqa: BLE001 - one broken fish never stops the others

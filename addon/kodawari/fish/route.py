@@ -254,7 +254,12 @@ def install(obj, rig, show_viewport=True, show_render=True):
     mod.show_viewport, mod.show_render = show_viewport, show_render
     move_first(obj, mod)
     rig.installed_on = mesh.as_pointer()
+    # Blender reports the attributes written here as a change of the mesh: the rig was
+    # just bound to this very rest shape, so that report needs no rest check (which would
+    # read every position and make Blender copy them, 12 bytes per vertex).
+    rig.own_update = True
     rig.release_coordinates()  # the attribute holds them now
+    rig.kn.release_free_memory()  # and the bind's scratch goes back to the system
     return mod
 
 

@@ -56,6 +56,15 @@ def get_rig(obj, build=True, known_weights=None, check_rest=False):
     return rig
 
 
+def consume_own_update(obj):
+    """True once after the route wrote its attributes into the object's mesh (route.install)."""
+    rig = _rigs.get(_key(obj))
+    if rig is None or not getattr(rig, "own_update", False):
+        return False
+    rig.own_update = False
+    return True
+
+
 def adopt(obj, rig):
     """Keep a rig bound for obj on trial (Add Fish Swim) instead of binding the mesh again:
     same rest shape and settings. A rig bound with other settings is dropped and get_rig
