@@ -116,7 +116,8 @@ def fish_table(runs, out):
     )
     out.append("")
     out.append(
-        "Kodawari = live handler, native FFD, shape-key write, Blender's evaluation of the key. "
+        "Kodawari = live handler (control axis, frame table into the Fish Swim modifier's helper), then "
+        "Blender's evaluation of the Fish Swim Geometry Nodes modifier (bound attribute, Sample Index). "
         "Geometry Nodes = Sample Curve → Set Position along the same animated curve (the fish's own control "
         "axis, keyed per frame). Curve modifier = the same curve. Floor = the same mesh whose only change is "
         "an animated shape-key value. Ratios use the medians; memory ratios the peak above start."

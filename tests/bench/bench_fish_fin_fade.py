@@ -4,8 +4,8 @@ out/bench.json -> fish_fin_fade).
 A smooth welded spindle fish (blend_samples/smooth_fish.py) subdivided to about 1 M
 vertices, its fins found by Find Fins and flapping (FLAP, 0.6 rad, feathering 0.5).
 Two sides, timed interleaved round by round in one process, whole frame
-(`scene.frame_set`: the handler's body FFD, every fin part's displacement, the shape key
-write): the fins faded in over the reach squashed along their swing (what ships,
+(`scene.frame_set`: the handler's frame table and every fin part's displacement, written
+into the Fish Swim modifier's helpers, then Blender's evaluation of the modifier): the fins faded in over the reach squashed along their swing (what ships,
 docs/algorithms.md §2.4) and over the plain reach (before). The squash changes only the
 reach the binding stores, so the frames should cost the same; the binding pays one more
 reach pass, printed beside it.
