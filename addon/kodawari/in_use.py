@@ -8,7 +8,10 @@ def swim(obj):
     settings = obj.kodawari_swim
     keys = obj.data.shape_keys
     has_key = keys is not None and "Kodawari Swim" in keys.key_blocks  # an older file
-    has_modifier = obj.modifiers.get("Fish Swim") is not None
+    has_modifier = any(
+        m.type == "NODES" and m.node_group is not None and m.node_group.get("kodawari_swim")
+        for m in obj.modifiers
+    )
     return settings.enabled or settings.baked != "NONE" or has_key or has_modifier
 
 

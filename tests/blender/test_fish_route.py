@@ -59,6 +59,32 @@ def test_the_modifier_shows_what_the_core_computes_on_the_sample_fish(empty_scen
     assert worst < 1e-5, f"{kind}: the modifier is {worst:.2e} body lengths from the core"
 
 
+def test_the_tree_for_vertices_past_the_axis_ends_is_exact_too(empty_scene, monkeypatch):
+    # The sample fish have no vertex past an end of their axis (w = 0 everywhere, the lean
+    # tree); the full tree (w packed into s, docs/algorithms.md §1.6) must be as exact.
+    from kodawari.fish import route
+
+    monkeypatch.setattr(route, "has_ends", lambda packed: True)
+    set_fps(24)
+    obj = make_fish("tuna")
+    add_swim(obj, fins=("fin_pectoral", "fin_caudal"), head_axis="POS_X", frequency=2.0)
+    assert any(n.type == "CLAMP" for n in obj.modifiers[MODIFIER].node_group.nodes)
+    worst, moved = _route_equals_core(obj, (2, 7))
+    assert moved > 0.02 and worst < 1e-5, worst
+
+
+def test_a_renamed_fish_swim_modifier_still_swims_and_goes_with_remove(empty_scene):
+    set_fps(24)
+    obj = make_fish("tuna")
+    add_swim(obj, head_axis="POS_X", frequency=2.0)
+    obj.modifiers[MODIFIER].name = "Body wave"
+    worst, moved = _route_equals_core(obj, (3, 6))
+    assert moved > 0.02 and worst < 1e-5
+    activate(obj)
+    assert bpy.ops.kodawari.swim_remove() == {"FINISHED"}
+    assert len(obj.modifiers) == 0
+
+
 @pytest.mark.parametrize("form", ["spindle", "cetacean", "eel"])
 def test_the_modifier_shows_what_the_core_computes_on_a_smooth_fish_with_a_mouth(
     empty_scene, form

@@ -25,16 +25,18 @@ COORDINATES = ".kodawari_swim_ffd"  # float3 per vertex: (s, u, v), docs/algorit
 FIN_INDEX = ".kodawari_swim_fin"  # int per vertex: its row in the fin helper, -1 off the fins
 FIN_OFFSET = "offset"
 SEGMENTS = 1024
+ROWS = SEGMENTS + 1  # one more row: the tail's frame, read at s = 1024 with no change after it
 FIELDS = ("o", "do", "e1", "de1", "e2", "de2", "e3", "de3")  # rows of AxisBinding.frame_table
 REST = "rest_"  # the rest table's fields, read only when the mesh has shape keys
 
 
 def modifier(obj):
-    """The object's Fish Swim modifier (a Geometry Nodes modifier running our group)."""
-    mod = obj.modifiers.get(MODIFIER)
-    if mod is None or mod.type != "NODES" or mod.node_group is None:
-        return None
-    return mod if mod.node_group.get("kodawari_swim") else None
+    """The object's Fish Swim modifier: the Geometry Nodes modifier running our group (found
+    by the group's mark, so a renamed modifier is still the swim)."""
+    for mod in obj.modifiers:
+        if mod.type == "NODES" and mod.node_group is not None and mod.node_group.get("kodawari_swim"):
+            return mod
+    return None
 
 
 def _helper(group, label):
@@ -113,9 +115,10 @@ class _Tree:
         return info.outputs["Geometry"]
 
 
-def build_group(table_obj, fins_obj, end_scale, with_keys=False):
+def build_group(table_obj, fins_obj, end_scale, with_keys=False, with_ends=True):
     """P' = (O + u e2 + v e3 + w e1) + f (dO + u de2 + v de3 + w de1) [+ fin offset], the
-    core's deform_vertex (docs/algorithms.md §1.4, §1.6) in nodes."""
+    core's deform_vertex (docs/algorithms.md §1.4, §1.6) in nodes. with_ends: some vertex
+    lies past an end of the axis (w != 0); without, the w terms are left out."""
     group = bpy.data.node_groups.new(GROUP, "GeometryNodeTree")
     group["kodawari_swim"] = 1
     _new_socket(group, "Geometry", "INPUT")
@@ -126,23 +129,28 @@ def build_group(table_obj, fins_obj, end_scale, with_keys=False):
     split = tree.node("ShaderNodeSeparateXYZ")
     tree.links.new(tree.named(COORDINATES, "FLOAT_VECTOR"), split.inputs[0])
     s, u, v = split.outputs["X"], split.outputs["Y"], split.outputs["Z"]
-    t = tree.node("ShaderNodeClamp")
-    tree.links.new(s, t.inputs["Value"])
-    t.inputs["Min"].default_value, t.inputs["Max"].default_value = 0.0, float(SEGMENTS)
-    t = t.outputs[0]
-    # Beyond an end the packing keeps w outside [0, 1024]: w = (s - clamp(s)) / end_scale.
-    w = tree.math("MULTIPLY", tree.math("SUBTRACT", s, t), 1.0 / end_scale)
-    segment = tree.math("MINIMUM", tree.math("FLOOR", t, 0.0), float(SEGMENTS - 1))
+    t, w = s, None
+    if with_ends:
+        clamp = tree.node("ShaderNodeClamp")
+        tree.links.new(s, clamp.inputs["Value"])
+        clamp.inputs["Min"].default_value, clamp.inputs["Max"].default_value = 0.0, float(SEGMENTS)
+        t = clamp.outputs[0]
+        # Beyond an end the packing keeps w outside [0, 1024]: w = (s - clamp(s)) / end_scale.
+        w = tree.math("MULTIPLY", tree.math("SUBTRACT", s, t), 1.0 / end_scale)
+    # t = 1024 (the tail) reads the last row, the tail's frame, at fraction 0.
+    segment = tree.math("FLOOR", t, 0.0)
     fraction = tree.math("SUBTRACT", t, segment)
+    fields = FIELDS if with_ends else tuple(f for f in FIELDS if not f.endswith("e1"))
 
     def bend(prefix):
-        row = {name: tree.sample(table, prefix + name, segment) for name in FIELDS}
+        row = {name: tree.sample(table, prefix + name, segment) for name in fields}
         at = tree.multiply_add(row["e2"], u, row["o"])
         at = tree.multiply_add(row["e3"], v, at)
-        at = tree.multiply_add(row["e1"], w, at)
         change = tree.multiply_add(row["de2"], u, row["do"])
         change = tree.multiply_add(row["de3"], v, change)
-        change = tree.multiply_add(row["de1"], w, change)
+        if w is not None:
+            at = tree.multiply_add(row["e1"], w, at)
+            change = tree.multiply_add(row["de1"], w, change)
         return tree.multiply_add(change, fraction, at)
 
     moved = bend("")
@@ -175,6 +183,21 @@ def build_group(table_obj, fins_obj, end_scale, with_keys=False):
 
 
 # ----------------------------------------------------------------------------- set-up
+
+
+def has_ends(packed):
+    """Some vertex lies past an end of the axis (w != 0: s outside [0, 1024])."""
+    return bool(np.any((packed[:, 0] < 0.0) | (packed[:, 0] > float(SEGMENTS))))
+
+
+def _rows(table, out):
+    """The core's frame table (8 * 1024, 3) as the helper's rows (8, 1025, 3): each field's
+    1024 segments, then the tail's frame (value + change of the last segment, no change)."""
+    segments = table.reshape(len(FIELDS), SEGMENTS, 3)
+    out[:, :SEGMENTS] = segments
+    out[0::2, SEGMENTS] = segments[0::2, -1] + segments[1::2, -1]  # o, e1, e2, e3 at t = 1
+    out[1::2, SEGMENTS] = 0.0
+    return out
 
 
 def _helper_object(name, count, attributes):
@@ -223,22 +246,27 @@ def _write_attribute(mesh, name, kind, values):
     attribute.data.foreach_set("vector" if kind == "FLOAT_VECTOR" else "value", values.reshape(-1))
 
 
-def install(obj, rig, show_viewport=True, show_render=True):
+def install(obj, rig):
     """Bind the route to the object's mesh for `rig` (runtime.SwimRig): the coordinate
     attributes, the helpers and the modifier, first in the stack. Replaces an earlier
-    installation (a rebind)."""
+    installation (a rebind). Its eye and camera are visibility.sync's to set."""
     mesh = obj.data
-    mod = obj.modifiers.get(MODIFIER)
+    mod = modifier(obj) or obj.modifiers.get(MODIFIER)
     if mod is not None and mod.type == "NODES":
         _remove_helpers(mod)
     else:
         mod = obj.modifiers.new(MODIFIER, "NODES")
-    _write_attribute(mesh, COORDINATES, "FLOAT_VECTOR", rig.packed_coordinates())
+    packed = rig.packed_coordinates()
+    with_ends = has_ends(packed)
+    _write_attribute(mesh, COORDINATES, "FLOAT_VECTOR", packed)
+    del packed
     with_keys = mesh.shape_keys is not None
-    table_obj = _helper_object(TABLE, SEGMENTS, FIELDS + tuple(REST + f for f in FIELDS))
-    rest_rows = rig.rest_table().reshape(len(FIELDS), SEGMENTS * 3)
-    for k, name in enumerate(FIELDS):
-        table_obj.data.attributes[REST + name].data.foreach_set("vector", rest_rows[k])
+    rest_fields = tuple(REST + f for f in FIELDS) if with_keys else ()
+    table_obj = _helper_object(TABLE, ROWS, FIELDS + rest_fields)
+    if with_keys:
+        rest_rows = _rows(rig.rest_table(), np.empty((len(FIELDS), ROWS, 3), np.float32))
+        for k, name in enumerate(rest_fields):
+            table_obj.data.attributes[name].data.foreach_set("vector", rest_rows[k].reshape(-1))
     fins_obj = None
     if rig.fin_vertices is not None:
         index = np.full(len(mesh.vertices), -1, np.int32)
@@ -247,11 +275,10 @@ def install(obj, rig, show_viewport=True, show_render=True):
         fins_obj = _helper_object(FINS, len(rig.fin_vertices), (FIN_OFFSET,))
     elif mesh.attributes.get(FIN_INDEX) is not None:
         mesh.attributes.remove(mesh.attributes[FIN_INDEX])
-    mod.node_group = build_group(table_obj, fins_obj, rig.end_scale, with_keys)
+    mod.node_group = build_group(table_obj, fins_obj, rig.end_scale, with_keys, with_ends)
     mod.node_group["kodawari_with_keys"] = with_keys
     # In Edit Mode the user edits the rest shape: show it, as the shape key used to.
     mod.show_in_editmode = False
-    mod.show_viewport, mod.show_render = show_viewport, show_render
     move_first(obj, mod)
     rig.installed_on = mesh.as_pointer()
     # Blender reports the attributes written here as a change of the mesh: the rig was
@@ -280,7 +307,7 @@ def installed_for(obj, rig):
 def uninstall(obj):
     """Remove the modifier, its node group, the helpers and the attributes: the mesh is as
     it was before the swim."""
-    mod = obj.modifiers.get(MODIFIER)
+    mod = modifier(obj) or obj.modifiers.get(MODIFIER)
     if mod is not None and mod.type == "NODES":
         _remove_helpers(mod)
         obj.modifiers.remove(mod)
@@ -292,15 +319,18 @@ def uninstall(obj):
                 mesh.attributes.remove(attribute)
 
 
+_row_buffer = np.empty((len(FIELDS), ROWS, 3), np.float32)
+
+
 def write_frame(obj, table, fin_offsets):
     """The frame's table (float32 (8 * 1024, 3)) and fin offsets (float32 (M, 3) or None)
     into the helpers; tags them so Blender re-evaluates the modifier."""
     table_mesh, fins_mesh = helpers(obj)
     if table_mesh is None:
         return False
-    rows = table.reshape(len(FIELDS), SEGMENTS * 3)
+    rows = _rows(table, _row_buffer)
     for k, name in enumerate(FIELDS):
-        table_mesh.attributes[name].data.foreach_set("vector", rows[k])
+        table_mesh.attributes[name].data.foreach_set("vector", rows[k].reshape(-1))
     table_mesh.update_tag()
     if fins_mesh is not None and fin_offsets is not None and len(fins_mesh.vertices) == len(fin_offsets):
         fins_mesh.attributes[FIN_OFFSET].data.foreach_set("vector", fin_offsets.reshape(-1))
