@@ -217,3 +217,6 @@ def test_the_live_mesh_carries_one_small_attribute_and_no_shape_key(empty_scene)
     ]
     assert added == [(".kodawari_swim_ffd", "FLOAT_VECTOR", "POINT")]
     assert obj.data.shape_keys is None
+    # ... and hands none on: what renders, exports and later modifiers see has no copy.
+    shown = obj.evaluated_get(bpy.context.evaluated_depsgraph_get()).data
+    assert not [a.name for a in shown.attributes if a.name.startswith(".kodawari")]

@@ -68,9 +68,8 @@ class KODAWARI_OT_swim_add(bpy.types.Operator):
         if error:
             self.report({"ERROR"}, error)
             return {"CANCELLED"}
-        rest = bulk.vertex_positions(obj.data)
         if self.head_axis == "AUTO":
-            head_axis, guess = midline.guess_head_axis(rest)
+            head_axis, guess = midline.guess_head_axis(bulk.vertex_positions(obj.data))
         else:
             head_axis, guess = (
                 self.head_axis,

@@ -178,7 +178,16 @@ def build_group(table_obj, fins_obj, end_scale, with_keys=False, with_ends=True)
     set_position = tree.node("GeometryNodeSetPosition")
     tree.links.new(group_in.outputs[0], set_position.inputs["Geometry"])
     tree.links.new(moved, set_position.inputs["Position"])
-    tree.links.new(set_position.outputs[0], group_out.inputs[0])
+    result = set_position.outputs[0]
+    # The bound attributes stay on the user's mesh, not on what the swim hands on: Blender
+    # 3.4 copies the mesh for Set Position (the attribute too, 12 bytes per vertex more
+    # until the next frame), and exports and later modifiers have no use for them.
+    for name in (COORDINATES, FIN_INDEX) if fins_obj is not None else (COORDINATES,):
+        remove = tree.node("GeometryNodeRemoveAttribute")
+        remove.inputs["Name"].default_value = name
+        tree.links.new(result, remove.inputs["Geometry"])
+        result = remove.outputs[0]
+    tree.links.new(result, group_out.inputs[0])
     return group
 
 
