@@ -220,3 +220,23 @@ def test_the_live_mesh_carries_one_small_attribute_and_no_shape_key(empty_scene)
     # ... and hands none on: what renders, exports and later modifiers see has no copy.
     shown = obj.evaluated_get(bpy.context.evaluated_depsgraph_get()).data
     assert not [a.name for a in shown.attributes if a.name.startswith(".kodawari")]
+
+
+def test_a_file_saved_with_the_old_swim_shape_key_plays_through_the_modifier(empty_scene):
+    # Before the modifier, the swim lived in a "Kodawari Swim" shape key over a Basis; such
+    # a file swims again on its next frame, through the modifier, its keys gone.
+    set_fps(24)
+    obj = make_fish("tuna")
+    original = rest(obj).copy()
+    settings = add_swim(obj, head_axis="POS_X", frequency=2.0)
+    from kodawari.fish import route, runtime
+
+    route.uninstall(obj)  # what the older add-on left in the file:
+    obj.shape_key_add(name="Basis", from_mix=False)
+    obj.shape_key_add(name="Kodawari Swim", from_mix=False).value = 1.0
+    runtime.forget(obj)
+    assert settings.enabled and runtime.has_swim(obj)
+    worst, moved = _route_equals_core(obj, (3, 5))
+    assert moved > 0.02 and worst < 1e-5
+    assert obj.data.shape_keys is None and obj.modifiers[0].name == MODIFIER
+    assert np.array_equal(rest(obj), original)
