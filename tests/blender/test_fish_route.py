@@ -86,9 +86,7 @@ def test_a_renamed_fish_swim_modifier_still_swims_and_goes_with_remove(empty_sce
 
 
 @pytest.mark.parametrize("form", ["spindle", "cetacean", "eel"])
-def test_the_modifier_shows_what_the_core_computes_on_a_smooth_fish_with_a_mouth(
-    empty_scene, form
-):
+def test_the_modifier_shows_what_the_core_computes_on_a_smooth_fish_with_a_mouth(empty_scene, form):
     set_fps(24)
     obj = smooth_fish.build_smooth_fish(form, subdivisions=2)
     for group in list(obj.vertex_groups):
@@ -125,9 +123,7 @@ def test_fish_swim_is_the_first_modifier_and_its_eye_hides_the_swim(empty_scene)
     assert np.abs(evaluated(obj) - original).max() > 1e-3, "shown again, it swims"
 
 
-def test_the_swim_survives_save_and_reload_with_its_helpers_out_of_the_scene(
-    empty_scene, tmp_path
-):
+def test_the_swim_survives_save_and_reload_with_its_helpers_out_of_the_scene(empty_scene, tmp_path):
     set_fps(24)
     obj = make_fish("tuna")
     add_swim(obj, fins=("fin_pectoral", "fin_caudal"), head_axis="POS_X", frequency=2.0)
@@ -212,9 +208,7 @@ def test_the_live_mesh_carries_one_small_attribute_and_no_shape_key(empty_scene)
     names = {a.name for a in obj.data.attributes}
     add_swim(obj, head_axis="POS_X", frequency=2.0)
     bpy.context.scene.frame_set(3)
-    added = [
-        (a.name, a.data_type, a.domain) for a in obj.data.attributes if a.name not in names
-    ]
+    added = [(a.name, a.data_type, a.domain) for a in obj.data.attributes if a.name not in names]
     assert added == [(".kodawari_swim_ffd", "FLOAT_VECTOR", "POINT")]
     assert obj.data.shape_keys is None
     # ... and hands none on: what renders, exports and later modifiers see has no copy.

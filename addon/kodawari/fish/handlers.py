@@ -7,7 +7,6 @@ from bpy.app.handlers import persistent
 from .. import problems
 from . import runtime, visibility
 
-
 _edited = set()  # meshes whose geometry changed since the last frame (depsgraph updates)
 
 

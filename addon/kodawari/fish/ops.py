@@ -15,7 +15,6 @@ from . import rig as rig_module
 from .props import HEAD_AXES
 
 
-
 def _active_mesh(context):
     return (
         context.active_object
@@ -148,11 +147,7 @@ class KODAWARI_OT_swim_remove(bpy.types.Operator):
             self.report({"ERROR"}, tip_("Select the swimming mesh object first"))
             return {"CANCELLED"}
         settings = obj.kodawari_swim
-        if (
-            not settings.enabled
-            and settings.baked == "NONE"
-            and not runtime.has_swim(obj)
-        ):
+        if not settings.enabled and settings.baked == "NONE" and not runtime.has_swim(obj):
             self.report({"ERROR"}, tip_("'{}' has no Fish Swim to remove").format(obj.name))
             return {"CANCELLED"}
         error = editable.why_not(obj, tip_("lose its swim"))

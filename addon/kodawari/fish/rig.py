@@ -217,7 +217,9 @@ class SwimRig:
         if self.binding.released:
             # What the modifier computes, in the core (docs/algorithms.md §1.6).
             self.binding.frame_table(self.axis, self.table)
-            self.kn.ffd_deform_packed(self.table, self.packed_coordinates(), self.end_scale, positions)
+            self.kn.ffd_deform_packed(
+                self.table, self.packed_coordinates(), self.end_scale, positions
+            )
         else:
             self.binding.deform(self.axis, positions)
         if not self.parts:
@@ -254,4 +256,3 @@ class SwimRig:
                 part.out,
             )
             yield part
-

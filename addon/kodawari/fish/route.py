@@ -34,7 +34,11 @@ def modifier(obj):
     """The object's Fish Swim modifier: the Geometry Nodes modifier running our group (found
     by the group's mark, so a renamed modifier is still the swim)."""
     for mod in obj.modifiers:
-        if mod.type == "NODES" and mod.node_group is not None and mod.node_group.get("kodawari_swim"):
+        if (
+            mod.type == "NODES"
+            and mod.node_group is not None
+            and mod.node_group.get("kodawari_swim")
+        ):
             return mod
     return None
 
@@ -341,7 +345,11 @@ def write_frame(obj, table, fin_offsets):
     for k, name in enumerate(FIELDS):
         table_mesh.attributes[name].data.foreach_set("vector", rows[k].reshape(-1))
     table_mesh.update_tag()
-    if fins_mesh is not None and fin_offsets is not None and len(fins_mesh.vertices) == len(fin_offsets):
+    if (
+        fins_mesh is not None
+        and fin_offsets is not None
+        and len(fins_mesh.vertices) == len(fin_offsets)
+    ):
         fins_mesh.attributes[FIN_OFFSET].data.foreach_set("vector", fin_offsets.reshape(-1))
         fins_mesh.update_tag()
     return True

@@ -14,7 +14,7 @@ import contextlib
 import bpy
 import mathutils
 
-from .. import bulk, problems
+from .. import problems
 from . import path, route, timing, visibility
 from . import rig as rig_module
 
