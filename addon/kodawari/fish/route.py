@@ -299,7 +299,6 @@ def install(obj, rig):
     # read every position and make Blender copy them, 12 bytes per vertex).
     rig.own_update = True
     rig.release_coordinates()  # the attribute holds them now
-    rig.kn.release_free_memory()  # and the bind's scratch goes back to the system
     return mod
 
 

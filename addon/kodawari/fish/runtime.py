@@ -147,6 +147,9 @@ def ensure_route(obj, rig):
     drop_swim_key(obj)
     route.install(obj, rig)
     visibility.sync(obj)
+    # The bind's and the install's scratch (rest positions, closest-point search, packed
+    # copies: tens of bytes per vertex, all freed by now) goes back to the system.
+    rig.kn.release_free_memory()
 
 
 def travel_direction(obj, rig):
