@@ -35,7 +35,7 @@ def swim_target(obj):
         ).format(obj.name, tuple(round(s, 4) for s in scale))
     if obj.data.shape_keys is not None:
         return tip_(
-            "'{}' already has shape keys: Fish Swim writes its own shape key on a clean mesh; apply or remove the existing ones first"
+            "'{}' already has shape keys: Fish Swim binds the mesh's own shape; apply or remove the shape keys first"
         ).format(obj.name)
     if len(obj.modifiers):
         names = ", ".join(m.name for m in obj.modifiers)

@@ -491,7 +491,7 @@ STRINGS = {
     "Gait bake": "歩容のベイク",
     "Fish swim bake": "魚の泳ぎのベイク",
     # Refusals and errors shown in the report area (tip_ msgids)
-    "'{}' already has shape keys: Fish Swim writes its own shape key on a clean mesh; apply or remove the existing ones first": "'{}' にはすでにシェイプキーがあります：魚の泳ぎはまっさらなメッシュに独自のシェイプキーを書き込みます。先に既存のシェイプキーを適用するか削除してください",
+    "'{}' already has shape keys: Fish Swim binds the mesh's own shape; apply or remove the shape keys first": "'{}' にはすでにシェイプキーがあります：魚の泳ぎはメッシュ自体の形にバインドします。先にシェイプキーを適用するか削除してください",
     "'{}' has a negative (mirroring) scale: apply the scale first": "'{}' のスケールが負（ミラー）です：先にスケールを適用してください",
     "'{}' has a negative or zero scale {}: apply the scale (Ctrl+A) first": "'{}' のスケール {} が負またはゼロです：先にスケールを適用（Ctrl+A）してください",
     "'{}' has a non-uniform scale ({}): apply the scale (Ctrl+A > Scale) first": "'{}' のスケール（{}）が均一ではありません：先にスケールを適用（Ctrl+A > スケール）してください",
