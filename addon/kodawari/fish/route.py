@@ -2,14 +2,14 @@
 
 The live swim bends the fish inside Blender's own evaluation: a "Fish Swim" Geometry
 Nodes modifier, first in the stack, reads each vertex's bound FFD coordinates (one
-3-float attribute, bound once) and the current frame table (1024 segments x 8 vectors,
-written per frame into a small helper mesh) and sets the bent positions with Sample
-Index nodes. Moving fins add a per-vertex offset the core computes per frame for the
+3-float attribute, bound once) and the current frame table (1024 segments x 8 vectors
+and the tail's frame, written per frame into a small helper mesh) and sets the bent
+positions with Sample Index nodes. Moving fins add a per-vertex offset the core computes per frame for the
 fin vertices only, written into a second helper mesh and read by an index attribute.
 
-The helpers (node group, helper objects and meshes) are named with a leading dot, which
-Blender leaves out of its ID menus; the helper objects belong to no collection, so the
-Outliner's scene views do not show them. They are reached from the modifier alone (no
+The helpers (node group, helper objects and meshes) are named with a leading dot, Blender's
+mark for data not meant for the user's lists; the helper objects belong to no collection,
+so the Outliner's scene views do not show them (its Blender File view does). They are reached from the modifier alone (no
 name lookups), save with the .blend, and go with Remove Fish Swim. The node tree is built
 here in code from nodes Blender 3.4 already has (no rotation or matrix sockets).
 """
