@@ -16,7 +16,7 @@ pose it renders.
 import numpy as np
 
 from .. import bulk, native, problems
-from . import chains
+from . import chains, predict
 
 # The solver state of the last evaluated frame is saved into the .blend (save_pre)
 # so that a reloaded file continues exactly where it stopped.
@@ -168,6 +168,11 @@ class ArmatureRuntime:
                 parent, reference, _chain = chains.resolve_rod(obj, rod)
                 read.update((index[parent.name], index[reference.name]))
         read.update(index[c.bone] for c in colliders)
+        self.input_bones = sorted(read)  # what a prediction must know (predict.py)
+        self.written_bones = sorted(set(rod_bones))
+        self.predictor = None  # built at the first new frame (predict.PosePredictor)
+        self.prediction_off = None  # why this rig's frames are not predicted, once known
+        self.predicted = None  # the prediction made before the pass, until checked after it
         self.matrix_bones = (
             sorted(read) if len(read) * SPARSE_READ_RATIO <= self.bone_count else None
         )
@@ -204,7 +209,7 @@ class ArmatureRuntime:
             camera_position = np.array(
                 _evaluated(camera, depsgraph).matrix_world.translation, np.float64
             )
-        gravity = np.array(scene.gravity if scene.use_gravity else (0.0, 0.0, 0.0), np.float64)
+        gravity = _gravity(scene)
         armature_matrix = np.array([tuple(row) for row in evaluated.matrix_world], np.float64)
         return armature_matrix, camera_position, gravity
 
@@ -234,15 +239,17 @@ class ArmatureRuntime:
             _tag(obj)
 
     def show_cached(self, obj, scene, frame):
-        """Before Blender evaluates `frame` (frame_change_pre): a frame the cache holds needs no
-        evaluated input, so its rotations go into the armature now and Blender evaluates the
-        frame once, with them, instead of twice (§3.7). Returns whether the frame was cached."""
+        """Before Blender evaluates `frame` (frame_change_pre): a frame the cache holds, or a new
+        frame whose inputs can be predicted (_predict), needs no evaluated input, so its rotations
+        go into the armature now and Blender evaluates the frame once, with them, instead of
+        twice (§3.7). Returns whether the frame was written."""
         if frame <= scene.frame_start or self.system.rod_count == 0:
             return False
         pose_bones = obj.pose.bones
         self._read_other_rotations(pose_bones)
         if not self.system.recall_frame(frame, self.rotations, load_state=self.last_frame != frame):
-            return False
+            if not self._predict(obj, scene, frame):
+                return False
         self.last_frame = frame
         if not self._holds(pose_bones):
             bulk.set_pose_rotations(pose_bones, self.rotations)
@@ -253,6 +260,89 @@ class ArmatureRuntime:
                 _tag(obj)
                 return True
         self._write_evaluated(obj, frame)
+        return True
+
+    def _previous_frame(self, frame):
+        """The frame `frame` steps on from: the solver's own state when it was the last one
+        simulated (the budget may already have dropped it from the cache), else the latest
+        cached one."""
+        if self.last_frame == frame - 1:
+            return self.last_frame
+        return self.system.latest_cached_frame_before(frame)
+
+    def _predict(self, obj, scene, frame):
+        """Solves the frame after the last simulated one from inputs predicted before Blender
+        evaluates it (predict.py); evaluate() checks them against Blender's after the pass.
+        False (nothing changed) when this rig's or this frame's inputs cannot be predicted."""
+        previous = self._previous_frame(frame)
+        if previous != frame - 1 or self.prediction_off is not None or scene.frame_subframe:
+            return False
+        if self.predictor is None:
+            try:
+                self.predictor = predict.PosePredictor(obj, self.input_bones, self.written_bones)
+            except predict.Unpredictable as exc:
+                self.prediction_off = str(exc)
+                return False
+        time = scene.frame_current_final
+        camera = active_camera(scene, frame)
+        camera_position = None
+        if camera is not None:
+            camera_position = self.predictor.camera_position(camera, time)
+            if camera_position is None:
+                return False  # a camera moved by more than its own action: this frame only
+        try:
+            matrices, armature_matrix = self.predictor.predict(time)
+        except (predict.Unpredictable, ValueError) as exc:
+            self.prediction_off = str(exc)
+            return False
+        gravity = _gravity(scene)
+        self.matrices[self.input_bones] = matrices
+        fps = scene.render.fps / scene.render.fps_base
+        if self.last_frame != previous:
+            self.system.recall_frame(previous)
+        self.system.step(
+            self.matrices,
+            armature_matrix,
+            camera_position,
+            gravity,
+            frame / fps,
+            (frame - previous) / fps,
+            self.rotations,
+        )
+        self.predicted = predict.Prediction(
+            frame, previous, matrices, armature_matrix, camera_position, gravity, self.rotations
+        )
+        self.status = "" if camera is not None else NO_CAMERA
+        return True
+
+    def _confirm(self, prediction, obj, scene, frame, depsgraph):
+        """After the pass that follows a prediction: the frame stands when Blender's inputs are
+        the predicted ones; otherwise it is solved again from Blender's (the state before the
+        step restored, written and tagged: a second pass) and this rig's frames are no longer
+        predicted until playback restarts. Returns False when the pass was of another frame."""
+        if prediction.frame != frame or self.last_frame != frame:
+            self.system.recall_frame(prediction.previous)  # undo the step nobody evaluated
+            self.last_frame = prediction.previous
+            return False
+        armature_matrix, camera, gravity = self._inputs(obj, scene, frame, depsgraph)
+        rods = self.rod_bones
+        self.rotations[rods] = prediction.rotations[rods]
+        wrong = prediction.mismatch(self.matrices[self.input_bones], armature_matrix, camera, gravity)
+        if wrong is not None:
+            self.prediction_off = wrong
+            fps = scene.render.fps / scene.render.fps_base
+            self.system.recall_frame(prediction.previous)
+            self.system.step(
+                self.matrices,
+                armature_matrix,
+                camera,
+                gravity,
+                frame / fps,
+                (frame - prediction.previous) / fps,
+                self.rotations,
+            )
+        self.system.store_frame(frame, self.rotations)
+        self._write(obj, depsgraph)
         return True
 
     def _write_evaluated(self, obj, frame):
@@ -308,6 +398,9 @@ class ArmatureRuntime:
         if self.system.rod_count == 0:
             self.status = ""
             return
+        prediction, self.predicted = self.predicted, None
+        if prediction is not None and self._confirm(prediction, obj, scene, frame, depsgraph):
+            return
         if frame > scene.frame_start:
             self._read_other_rotations(_evaluated(obj, depsgraph).pose.bones)
             if self.system.recall_frame(frame, self.rotations, load_state=self.last_frame != frame):
@@ -315,12 +408,7 @@ class ArmatureRuntime:
                 self.status = "" if active_camera(scene, frame) is not None else NO_CAMERA
                 self._write(obj, depsgraph)
                 return
-        # The frame before, from the solver's own state when it was the last one simulated (the
-        # budget may already have dropped it from the cache), else the latest cached one.
-        if self.last_frame == frame - 1:
-            previous = self.last_frame
-        else:
-            previous = self.system.latest_cached_frame_before(frame)
+        previous = self._previous_frame(frame)
         if (
             frame > scene.frame_start
             and (previous is None or previous < frame - 1)
@@ -333,6 +421,7 @@ class ArmatureRuntime:
         fps = scene.render.fps / scene.render.fps_base
         armature_matrix, camera, gravity = self._inputs(obj, scene, frame, depsgraph)
         if frame <= scene.frame_start or previous is None:
+            self.predictor, self.prediction_off = None, None  # looked at afresh from the start
             self.system.clear_cache()
             self.system.reset(
                 self.matrices, armature_matrix, camera, gravity, frame / fps, self.rotations
@@ -358,6 +447,10 @@ class ArmatureRuntime:
         if slot is None or self.last_frame is None:
             return None
         return self.system.weights(slot)
+
+
+def _gravity(scene):
+    return np.array(scene.gravity if scene.use_gravity else (0.0, 0.0, 0.0), np.float64)
 
 
 def _evaluated(obj, depsgraph):
@@ -446,9 +539,8 @@ def evaluate_scene(scene, depsgraph=None):
 
 
 def show_cached_frames(scene):
-    """frame_change_pre: writes the frames the caches hold before Blender evaluates them."""
-    if _replaying:
-        return
+    """frame_change_pre: writes the frames the caches hold, and new frames whose inputs can be
+    predicted (also while a jump replays the skipped frames), before Blender evaluates them."""
     for obj in hair_armatures(scene):
         rt = get(obj, build=False)
         if rt is None:
