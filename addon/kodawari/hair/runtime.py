@@ -173,6 +173,7 @@ class ArmatureRuntime:
         self.predictor = None  # built at the first new frame (predict.PosePredictor)
         self.prediction_off = None  # why this rig's frames are not predicted, once known
         self.predicted = None  # the prediction made before the pass, until checked after it
+        self.rotation_view = None  # bulk.PoseRotationView once built, False when refused
         self.matrix_bones = (
             sorted(read) if len(read) * SPARSE_READ_RATIO <= self.bone_count else None
         )
@@ -252,14 +253,37 @@ class ArmatureRuntime:
                 return False
         self.last_frame = frame
         if not self._holds(pose_bones):
-            bulk.set_pose_rotations(pose_bones, self.rotations)
-            if bulk.POSE_WRITE_TAGS:
+            if not bulk.POSE_WRITE_TAGS:
+                bulk.set_pose_rotations(pose_bones, self.rotations)
+            elif not self._write_original_directly(pose_bones):
+                bulk.set_pose_rotations(pose_bones, self.rotations)
                 # Blender copies the armature from these in the coming evaluation anyway: a
                 # write into its current copy would be lost. The tag makes sure of the copy.
                 self.pending = None
                 _tag(obj)
                 return True
         self._write_evaluated(obj, frame)
+        return True
+
+    def _write_original_directly(self, pose_bones):
+        """Blender 4.x: writes the rod bones' rotations into the original pose in memory
+        (bulk.PoseRotationView), so no RNA update tags the armature and Blender does not copy
+        the whole object in the coming evaluation (§3.7); the evaluated copy is written next.
+        The view is checked against what RNA just read (self.held) before every write. False
+        when there is no valid view: the caller writes through RNA."""
+        view = self.rotation_view
+        pose = pose_bones.id_data.pose
+        if view is None:
+            view = self.rotation_view = (
+                bulk.PoseRotationView.create(pose, self.written_bones) or False
+            )
+        if view is False or not view.current(pose):
+            self.rotation_view = False
+            return False
+        if not np.array_equal(view.read(), self.held[view.indices]):
+            self.rotation_view = False  # the memory is not what RNA shows: never again here
+            return False
+        view.write(self.rotations)
         return True
 
     def _previous_frame(self, frame):
