@@ -1,0 +1,207 @@
+"""A new hair frame solved before Blender evaluates it (issue 13 item 2, docs/algorithms.md §3.7).
+
+When the rods' parent bones are moved only by the armature's action, the add-on predicts them
+before the evaluation, solves and writes the hair, and checks the prediction after it. What a
+user sees must be exactly what the post-evaluation path (solve after Blender's evaluation,
+write, evaluate again) shows, whatever moves the head: an action (predicted), a constraint or
+a driver (not predictable), or a driver added in the middle of playback (a wrong prediction,
+caught and solved again in the same frame)."""
+
+import bpy
+import numpy as np
+import pytest
+from hair_rig import add_camera, chain_bones, make_rig, select_only
+
+HEAD_KEYS = (
+    (1, (0.0, 0.0, 0.0), (0.0, 0.0, 0.0)),
+    (7, (0.35, 0.0, 0.15), (0.3, 0.0, 0.2)),
+    (14, (-0.3, 0.2, 0.0), (-0.2, 0.4, 0.0)),
+    (22, (0.0, -0.1, 0.05), (0.0, 0.0, -0.3)),
+)
+FRAMES = range(1, 31)
+
+
+def _rig(scene, head_by="action"):
+    """Root -> Head (Euler XYZ) with a 5-bone rod on the head, Root turned, a front camera.
+    The head moves by its own keys ("action") or copies a keyed control bone's local
+    transform through a constraint ("constraint"): the same motion."""
+    obj = make_rig(scene)
+    select_only(obj, {"Ahoge.00"})
+    assert bpy.ops.kodawari.rod_add() == {"FINISHED"}
+    obj.kodawari_hair.rods[0].stiffness = 0.3
+    obj.pose.bones["Root"].rotation_quaternion = (0.9962, 0.0, 0.0872, 0.0)  # 10 deg, static
+    head = obj.pose.bones["Head"]
+    head.rotation_mode = "XYZ"
+    driver = head
+    if head_by == "constraint":
+        # A control bone with the head's rest, keyed; the head copies its local transform.
+        bpy.ops.object.mode_set(mode="EDIT")
+        control = obj.data.edit_bones.new("HeadControl")
+        rest = obj.data.edit_bones["Head"]
+        control.head, control.tail, control.roll = rest.head, rest.tail, rest.roll
+        control.parent = rest.parent
+        bpy.ops.object.mode_set(mode="POSE")
+        head = obj.pose.bones["Head"]
+        driver = obj.pose.bones["HeadControl"]
+        driver.rotation_mode = "XYZ"
+        con = head.constraints.new("COPY_TRANSFORMS")
+        con.target, con.subtarget = obj, "HeadControl"
+        con.target_space = con.owner_space = "LOCAL"
+    for frame, location, rotation in HEAD_KEYS:
+        driver.location, driver.rotation_euler = location, rotation
+        driver.keyframe_insert("location", frame=frame)
+        driver.keyframe_insert("rotation_euler", frame=frame)
+    add_camera(scene, "Front", (0, -4, 1.7))
+    scene.frame_start, scene.frame_end = 1, 40
+    bpy.ops.object.mode_set(mode="OBJECT")
+    return obj
+
+
+def _seen(obj):
+    """What the user sees after frame_set: the rod bones' rotations in the original pose (what a
+    save or a render starts from) and in the evaluated pose, and the evaluated joints."""
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    evaluated = obj.evaluated_get(depsgraph)
+    bones = chain_bones(obj, "Ahoge")
+    names = [pb.name for pb in bones]
+    original = np.array([tuple(pb.rotation_quaternion) for pb in bones])
+    shown = np.array([tuple(evaluated.pose.bones[n].rotation_quaternion) for n in names])
+    joints = np.array(
+        [tuple(evaluated.pose.bones[n].head) for n in names]
+        + [tuple(evaluated.pose.bones[names[-1]].tail)]
+    )
+    return original, shown, joints
+
+
+def _runtime(obj):
+    from kodawari.hair import runtime
+
+    return runtime.get(obj)
+
+
+def _play(scene, obj, frames, before_frame=None):
+    seen = {}
+    for frame in frames:
+        if before_frame is not None:
+            before_frame(frame)
+        scene.frame_set(frame)
+        seen[frame] = _seen(obj)
+        original, shown, joints = seen[frame]
+        np.testing.assert_array_equal(shown, original, err_msg=f"frame {frame}: stale screen")
+        solver = _runtime(obj).system.joint_positions(0)
+        np.testing.assert_allclose(joints, solver, atol=2e-4, err_msg=f"frame {frame}")
+    return seen
+
+
+@pytest.fixture
+def post_evaluation_path(monkeypatch):
+    """Every new frame solved after Blender's evaluation (the path before prediction)."""
+    from kodawari.hair import runtime
+
+    def switch():
+        monkeypatch.setattr(runtime.ArmatureRuntime, "_predict", lambda *args: False)
+
+    return switch
+
+
+def _assert_same(seen, reference, atol=1e-6):
+    for frame in reference:
+        for a, b, what in zip(seen[frame], reference[frame], ("original", "shown", "joints")):
+            np.testing.assert_allclose(a, b, atol=atol, err_msg=f"frame {frame}, {what}")
+
+
+class _FirstPass:
+    """After the add-on's frame_change_post: the rod rotations Blender's first evaluation of
+    the frame shows (before any second evaluation the add-on may ask for)."""
+
+    def __init__(self, obj):
+        self.obj, self.shown = obj, {}
+
+    def __call__(self, scene, depsgraph=None):
+        evaluated = self.obj.evaluated_get(depsgraph)
+        self.shown[scene.frame_current] = np.array(
+            [
+                tuple(evaluated.pose.bones[pb.name].matrix.to_quaternion())
+                for pb in chain_bones(self.obj, "Ahoge")
+            ]
+        )
+
+
+def test_a_head_moved_by_its_action_shows_its_new_hair_frames_in_one_evaluation(empty_scene):
+    scene = empty_scene
+    obj = _rig(scene)
+    first = _FirstPass(obj)
+    bpy.app.handlers.frame_change_post.append(first)  # runs after the add-on's handler
+    try:
+        seen = _play(scene, obj, FRAMES)
+    finally:
+        bpy.app.handlers.frame_change_post.remove(first)
+    assert np.abs(seen[30][0] - seen[1][0]).max() > 0.05, "the head should swing the chain"
+    final = _FirstPass(obj)
+    for frame in FRAMES[1:]:  # frames simulated for the first time, after the start frame
+        scene.frame_set(frame)
+        final(scene, bpy.context.evaluated_depsgraph_get())
+        # The first evaluation already showed the frame's hair: other handlers, render engines
+        # and the viewport see it without a second evaluation of the armature.
+        np.testing.assert_allclose(
+            first.shown[frame], final.shown[frame], atol=1e-6, err_msg=f"frame {frame}"
+        )
+
+
+def test_predicted_frames_equal_the_post_evaluation_path(empty_scene, post_evaluation_path):
+    scene = empty_scene
+    obj = _rig(scene)
+    predicted = _play(scene, obj, FRAMES)
+    assert _runtime(obj).prediction_off is None, "the action-driven head should be predicted"
+    bpy.ops.wm.read_homefile(use_empty=True, use_factory_startup=True)
+    scene = bpy.context.scene
+    obj = _rig(scene)
+    post_evaluation_path()
+    # The predicted inputs are Blender's within float32 rounding (6e-8 measured), not bit for bit.
+    _assert_same(predicted, _play(scene, obj, FRAMES), atol=1e-5)
+
+
+def test_a_head_moved_by_a_constraint_plays_as_the_same_motion_keyed(empty_scene):
+    scene = empty_scene
+    obj = _rig(scene, head_by="constraint")
+    constrained = _play(scene, obj, FRAMES)
+    assert _runtime(obj).prediction_off, "a constrained rig is not predictable"
+    bpy.ops.wm.read_homefile(use_empty=True, use_factory_startup=True)
+    scene = bpy.context.scene
+    obj = _rig(scene)
+    # Blender's constraint and its keyed channels place the head within float rounding.
+    _assert_same(constrained, _play(scene, obj, FRAMES), atol=1e-5)
+
+
+def _add_head_driver(obj):
+    fcurve = obj.driver_add('pose.bones["Head"].location', 0)
+    fcurve.driver.type = "SCRIPTED"
+    fcurve.driver.expression = "0.25"  # a constant: Blender's simple expressions, no Python
+    for modifier in list(fcurve.modifiers):
+        fcurve.modifiers.remove(modifier)
+
+
+def test_a_driver_added_during_playback_is_caught_and_corrected_the_same_frame(
+    empty_scene, post_evaluation_path
+):
+    frame = 11  # the driver appears just before this frame is set
+
+    def runs(post_path):
+        bpy.ops.wm.read_homefile(use_empty=True, use_factory_startup=True)
+        scene = bpy.context.scene
+        obj = _rig(scene)
+        if post_path:
+            post_evaluation_path()
+
+        def before(f):
+            if f == frame:
+                _add_head_driver(obj)
+
+        return _play(scene, obj, range(1, 21), before), obj
+
+    predicted, obj = runs(post_path=False)
+    assert _runtime(obj).prediction_off, "the driver should have refuted the prediction"
+    reference, _ = runs(post_path=True)
+    jump = np.abs(reference[frame][2] - reference[frame - 1][2]).max()
+    assert jump > 0.05, "the driver should move the head, and the hair with it"
+    _assert_same(predicted, reference, atol=1e-5)
