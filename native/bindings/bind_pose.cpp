@@ -43,7 +43,7 @@ void bind_pose(py::module_& m) {
         } catch (const std::invalid_argument& e) {
           throw py::value_error(e.what());
         }
-        require_finite_result(out.data(), static_cast<std::size_t>(out.size()), "pose_forward_kinematics");
+        require_finite_result(out.data(), static_cast<std::size_t>(out.size()), "channels and rest give a non-finite pose matrix (a scale or location too large)");
         return out;
       },
       py::arg("parents"), py::arg("rest"), py::arg("channels"), py::arg("rotation_modes"), py::arg("inherit_rotation"),

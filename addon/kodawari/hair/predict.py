@@ -175,8 +175,14 @@ class PosePredictor:
         ).reshape(-1, 16)
         modes, inherit_rotation, inherit_scale = [], [], []
         for pb in self.bones:
-            if pb.bone.inherit_scale not in INHERIT_SCALE:
-                raise Unpredictable(f"bone '{pb.name}' inherits scale {pb.bone.inherit_scale}")
+            scale_mode = pb.bone.inherit_scale
+            # NONE and AVERAGE under an inherited rotation take the parent's orientation without
+            # its shear: measured off by up to 0.03 against Blender's evaluation under a sheared
+            # parent (with a hinge they match), so such rigs are left to the evaluated path.
+            if scale_mode not in INHERIT_SCALE or (
+                scale_mode in ("NONE", "AVERAGE") and pb.bone.use_inherit_rotation and pb.parent
+            ):
+                raise Unpredictable(f"bone '{pb.name}' inherits scale {scale_mode}")
             if pb.parent is not None and not pb.bone.use_local_location:
                 raise Unpredictable(f"bone '{pb.name}' moves in the armature's space")
             modes.append(ROTATION_MODES[pb.rotation_mode])

@@ -4,10 +4,11 @@
 // parent_pose · offset, offset = parent_rest⁻¹ · rest (the bone's rest frame in its parent's),
 // with the rotation/scale part changed by the bone's inherit flags:
 //   no inherited rotation (a hinge): the parent's REST orientation, scaled per axis by the
-//   parent's pose scale (FULL) or not (others);
-//   inherit scale NONE / AVERAGE: the parent's orientation made orthonormal (Gram-Schmidt
-//   from the Y axis, the bone axis), AVERAGE then scaled by the cube root of its volume;
-//   NONE_LEGACY: each axis of the parent's orientation normalised.
+//   parent's pose scale (FULL), by the cube root of its volume (AVERAGE) or not (NONE,
+//   NONE_LEGACY);
+//   NONE_LEGACY under an inherited rotation: each axis of the parent's orientation normalised.
+// NONE and AVERAGE under an inherited rotation (Blender removes the parent's shear there) are
+// refused: not matched against Blender's evaluation under a sheared parent.
 // The location always moves along parent_pose · offset (these flags leave it alone).
 #include "kodawari/pose/forward_kinematics.hpp"
 
@@ -54,23 +55,6 @@ Mat3 rotation_matrix(const double* rotation, int mode) {
   return euler_matrix(rotation, mode);
 }
 
-// Gram-Schmidt keeping the Y column's direction (the bone axis), then X, then Z; unit length.
-Mat3 orthonormal_from_y(const Mat3& m) {
-  Vec3 y = m.col(1), x = m.col(0), z = m.col(2);
-  const double yy = y.squaredNorm();
-  if (yy > 0.0) {
-    x -= y * (x.dot(y) / yy);
-    z -= y * (z.dot(y) / yy);
-    const double xx = x.squaredNorm();
-    if (xx > 0.0) z -= x * (z.dot(x) / xx);
-  }
-  Mat3 out;
-  out.col(0) = x.normalized();
-  out.col(1) = y.normalized();
-  out.col(2) = z.normalized();
-  return out;
-}
-
 Vec3 column_lengths(const Mat3& m) { return Vec3(m.col(0).norm(), m.col(1).norm(), m.col(2).norm()); }
 
 }  // namespace
@@ -108,7 +92,9 @@ void forward_kinematics(const std::vector<BoneChannels>& bones, double* out) {
       switch (b.inherit_scale) {
         case InheritScale::kFull: orientation = parent3; break;
         case InheritScale::kNone:
-        case InheritScale::kAverage: orientation = orthonormal_from_y(parent3); break;
+        case InheritScale::kAverage:
+          throw std::invalid_argument("inherit_scale[" + std::to_string(i) +
+                                      "]: NONE and AVERAGE need inherit_rotation 0 (a hinge)");
         case InheritScale::kNoneLegacy: orientation = parent3 * column_lengths(parent3).cwiseInverse().asDiagonal(); break;
       }
     } else {

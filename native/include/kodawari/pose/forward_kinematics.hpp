@@ -32,7 +32,8 @@ struct BoneChannels {
 
 // Writes each bone's armature-space pose matrix (row-major 4x4, 16 doubles per bone) into
 // `out`. Parents must come before their children. Throws std::invalid_argument on a parent
-// index that is not earlier, a rotation mode outside the numbering, or a singular rest matrix.
+// index that is not earlier, a rotation mode outside the numbering, a singular rest matrix, or
+// NONE / AVERAGE scale inheritance with an inherited rotation (not modelled).
 void forward_kinematics(const std::vector<BoneChannels>& bones, double* out);
 
 }  // namespace kodawari::pose
