@@ -141,13 +141,14 @@ class PoseRotationView:
     ListBase chanbase {first, last}; a bone added, even with another removed, appends a new
     channel), and the caller compares a read with RNA's before writing."""
 
-    def __init__(self, indices, offset, addresses, pose_address, first, last):
+    def __init__(self, indices, offset, addresses, pose_address, first, last, names):
         import ctypes
 
         base = int(addresses.min())
         span = int(addresses.max()) - base + offset + 16
         self.indices = indices
         self.pose = (pose_address, first, last)
+        self.names = names  # of the first and last bone, for agrees()
         memory = (ctypes.c_float * (span // 4)).from_address(base)
         self.memory = np.frombuffer(memory, np.float32)
         self.index = ((addresses - base + offset) // 4).astype(np.int64)[:, None] + np.arange(4)
@@ -180,11 +181,24 @@ class PoseRotationView:
         chanbase = cls._chanbase(pose)
         if chanbase[1:] != (int(every[0]), int(every[-1])):
             return None
-        return cls(indices, offset, addresses, *chanbase)
+        names = (pose_bones[int(indices[0])].name, pose_bones[int(indices[-1])].name)
+        return cls(indices, offset, addresses, *chanbase, names)
 
     def current(self, pose):
         """False once the pose or its channel list changed (a bone added or removed)."""
         return self._chanbase(pose) == self.pose
+
+    def agrees(self, pose):
+        """True when the first and last bone's rotations read here are RNA's (a name lookup is
+        hashed, an index one walks the list)."""
+        view = self.memory[self.index[[0, -1]]]
+        for row, name in zip(view, self.names):
+            pose_bone = pose.bones.get(name)
+            if pose_bone is None or tuple(row) != tuple(
+                np.float32(c) for c in pose_bone.rotation_quaternion
+            ):
+                return False
+        return True
 
     def read(self):
         """(N, 4) float32 copy of the rotations."""

@@ -224,9 +224,17 @@ class ArmatureRuntime:
         the whole object and a second evaluation, §3.7) only when the pose `depsgraph` has just
         evaluated was not already made from them, e.g. a frame show_cached() wrote before the
         evaluation or a chain at rest. Without a depsgraph the tag is unconditional."""
-        if not self._holds(obj.pose.bones):
+        view = self._original_view(obj)
+        if view is not None:
+            holds = np.array_equal(view.read(), self.rotations[view.indices])
+        else:
+            holds = self._holds(obj.pose.bones)
+        if not holds:
             self.pending = None
-            bulk.set_pose_rotations(obj.pose.bones, self.rotations)
+            if view is not None:
+                view.write(self.rotations)
+            else:
+                bulk.set_pose_rotations(obj.pose.bones, self.rotations)
             _tag(obj)
             return
         evaluated = _evaluated(obj, depsgraph)
@@ -252,11 +260,18 @@ class ArmatureRuntime:
             if not self._predict(obj, scene, frame):
                 return False
         self.last_frame = frame
+        view = self._original_view(obj)
+        if view is not None:
+            # The rod bones' rotations in Blender's memory (no RNA: nothing tagged, no update).
+            changed = np.zeros(self.bone_count, bool)
+            changed[view.indices] = np.any(view.read() != self.rotations[view.indices], axis=1)
+            if changed.any():
+                view.write(self.rotations)
+            self._write_evaluated(obj, frame, changed)
+            return True
         if not self._holds(pose_bones):
-            if not bulk.POSE_WRITE_TAGS:
-                bulk.set_pose_rotations(pose_bones, self.rotations)
-            elif not self._write_original_directly(pose_bones):
-                bulk.set_pose_rotations(pose_bones, self.rotations)
+            bulk.set_pose_rotations(pose_bones, self.rotations)
+            if bulk.POSE_WRITE_TAGS:
                 # Blender copies the armature from these in the coming evaluation anyway: a
                 # write into its current copy would be lost. The tag makes sure of the copy.
                 self.pending = None
@@ -265,26 +280,24 @@ class ArmatureRuntime:
         self._write_evaluated(obj, frame)
         return True
 
-    def _write_original_directly(self, pose_bones):
-        """Blender 4.x: writes the rod bones' rotations into the original pose in memory
-        (bulk.PoseRotationView), so no RNA update tags the armature and Blender does not copy
-        the whole object in the coming evaluation (§3.7); the evaluated copy is written next.
-        The view is checked against what RNA just read (self.held) before every write. False
-        when there is no valid view: the caller writes through RNA."""
+    def _original_view(self, obj):
+        """The rod bones' rotations in the original pose's memory (bulk.PoseRotationView), or
+        None where it is refused or out of date: then RNA. Without RNA, a write runs no update,
+        so in Blender 4.x it no longer has Blender copy the whole armature in the coming
+        evaluation, and in every Blender it skips a pass over every pose bone (§3.7). Checked
+        against the pose's channel list and against RNA (first and last rod bone) before use."""
         view = self.rotation_view
-        pose = pose_bones.id_data.pose
+        if view is False:
+            return None
+        pose = obj.pose
         if view is None:
-            view = self.rotation_view = (
-                bulk.PoseRotationView.create(pose, self.written_bones) or False
-            )
-        if view is False or not view.current(pose):
-            self.rotation_view = False
-            return False
-        if not np.array_equal(view.read(), self.held[view.indices]):
-            self.rotation_view = False  # the memory is not what RNA shows: never again here
-            return False
-        view.write(self.rotations)
-        return True
+            view = self.rotation_view = bulk.PoseRotationView.create(pose, self.written_bones) or False
+            if view is False:
+                return None
+        if not (view.current(pose) and view.agrees(pose)):
+            self.rotation_view = False  # the memory is not what RNA shows: RNA from now on
+            return None
+        return view
 
     def _previous_frame(self, frame):
         """The frame `frame` steps on from: the solver's own state when it was the last one
@@ -369,11 +382,13 @@ class ArmatureRuntime:
         self._write(obj, depsgraph)
         return True
 
-    def _write_evaluated(self, obj, frame):
+    def _write_evaluated(self, obj, frame, changed=None):
         """Writes the rotations into the viewport's evaluated armature too: when the frame change
         re-evaluates the pose (an animated parent), it does so with them and without copying the
         whole object again. Whether it did is checked after the evaluation (_was_evaluated);
-        without an evaluated copy to write, the armature is tagged (copied, evaluated once)."""
+        without an evaluated copy to write, the armature is tagged (copied, evaluated once).
+        `changed`: the bones whose rotation the original pose just changed (the evaluated copy
+        held what the original held), instead of reading the copy's rotations."""
         import bpy
 
         if self.pending is not None:  # an earlier write nobody evaluated: let Blender copy afresh
@@ -387,9 +402,12 @@ class ArmatureRuntime:
             _tag(obj)
             return
         pose_bones = evaluated.pose.bones
-        if self._holds(pose_bones):
-            return
-        changed = np.any(self.held != self.rotations, axis=1)
+        if changed is None:
+            if self._holds(pose_bones):
+                return
+            changed = np.any(self.held != self.rotations, axis=1)
+        elif not changed.any():
+            return  # evaluate() checks after the evaluation that the copy holds them
         before = bulk.pose_bone_matrices(pose_bones)
         bulk.set_pose_rotations(pose_bones, self.rotations)
         self.pending = (depsgraph.as_pointer(), frame, changed, before)
