@@ -89,7 +89,6 @@ def set_pose_rotations(pose_bones, rotations):
     pose_bones.foreach_set("rotation_quaternion", rotations.reshape(-1))
 
 
-
 # Pose-bone rotations without RNA, for Blender 4.x, where a foreach_set on the original pose
 # runs the RNA update: it tags the armature object and Blender then copies the whole object
 # (every pose channel) in the coming evaluation, 4.5-8.4x a bare evaluation at 160-16,000 bones
@@ -207,6 +206,7 @@ class PoseRotationView:
     def write(self, rotations):
         """rotations (B, 4) float32 for every bone; the view's bones are written."""
         self.memory[self.index] = rotations[self.indices]
+
 
 # Shape key data without RNA. A KeyBlock keeps its positions in one float array;
 # DNA_key_types.h lays out KeyBlock as

@@ -42,8 +42,19 @@ _BONE_CHANNELS = {
     "scale": (7, 3),
 }
 _ROTATION_PROPERTY = {"QUATERNION": "rotation_quaternion", "AXIS_ANGLE": "rotation_axis_angle"}
-_OBJECT_CHANNELS = ("location", "rotation_euler", "rotation_quaternion", "rotation_axis_angle", "scale")
-_OBJECT_DELTAS = ("delta_location", "delta_rotation_euler", "delta_rotation_quaternion", "delta_scale")
+_OBJECT_CHANNELS = (
+    "location",
+    "rotation_euler",
+    "rotation_quaternion",
+    "rotation_axis_angle",
+    "scale",
+)
+_OBJECT_DELTAS = (
+    "delta_location",
+    "delta_rotation_euler",
+    "delta_rotation_quaternion",
+    "delta_scale",
+)
 
 
 class Unpredictable(Exception):
@@ -104,9 +115,11 @@ class ObjectMotion:
         obj = self.obj
         if not self.curves:
             return _matrix(obj.matrix_basis)
-        if tuple(obj.delta_rotation_euler) != (0.0, 0.0, 0.0) or tuple(
-            obj.delta_rotation_quaternion
-        ) != (1.0, 0.0, 0.0, 0.0) or tuple(obj.delta_scale) != (1.0, 1.0, 1.0):
+        if (
+            tuple(obj.delta_rotation_euler) != (0.0, 0.0, 0.0)
+            or tuple(obj.delta_rotation_quaternion) != (1.0, 0.0, 0.0, 0.0)
+            or tuple(obj.delta_scale) != (1.0, 1.0, 1.0)
+        ):
             raise Unpredictable("the object has delta rotation or scale")
         values = {
             "location": list(obj.location),
@@ -274,7 +287,12 @@ class Prediction:
 
     def __init__(self, frame, previous, matrices, armature, camera, gravity, rotations):
         self.frame, self.previous = frame, previous
-        self.matrices, self.armature, self.camera, self.gravity = matrices, armature, camera, gravity
+        self.matrices, self.armature, self.camera, self.gravity = (
+            matrices,
+            armature,
+            camera,
+            gravity,
+        )
         self.rotations = rotations.copy()
 
     def mismatch(self, matrices, armature, camera, gravity):

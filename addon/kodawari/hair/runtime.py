@@ -256,9 +256,11 @@ class ArmatureRuntime:
             return False
         pose_bones = obj.pose.bones
         self._read_other_rotations(pose_bones)
-        if not self.system.recall_frame(frame, self.rotations, load_state=self.last_frame != frame):
-            if not self._predict(obj, scene, frame):
-                return False
+        cached = self.system.recall_frame(
+            frame, self.rotations, load_state=self.last_frame != frame
+        )
+        if not (cached or self._predict(obj, scene, frame)):
+            return False
         self.last_frame = frame
         view = self._original_view(obj)
         if view is not None:
@@ -291,7 +293,9 @@ class ArmatureRuntime:
             return None
         pose = obj.pose
         if view is None:
-            view = self.rotation_view = bulk.PoseRotationView.create(pose, self.written_bones) or False
+            view = self.rotation_view = (
+                bulk.PoseRotationView.create(pose, self.written_bones) or False
+            )
             if view is False:
                 return None
         if not (view.current(pose) and view.agrees(pose)):
@@ -364,7 +368,9 @@ class ArmatureRuntime:
         armature_matrix, camera, gravity = self._inputs(obj, scene, frame, depsgraph)
         rods = self.rod_bones
         self.rotations[rods] = prediction.rotations[rods]
-        wrong = prediction.mismatch(self.matrices[self.input_bones], armature_matrix, camera, gravity)
+        wrong = prediction.mismatch(
+            self.matrices[self.input_bones], armature_matrix, camera, gravity
+        )
         if wrong is not None:
             self.prediction_off = wrong
             fps = scene.render.fps / scene.render.fps_base
