@@ -292,6 +292,8 @@ class ArmatureRuntime:
         if view is False:
             return None
         pose = obj.pose
+        if pose is None:
+            return None
         if view is None:
             view = self.rotation_view = (
                 bulk.PoseRotationView.create(pose, self.written_bones) or False
