@@ -63,9 +63,8 @@ def vertex_group_weights(obj, group_name):
 
 def pose_bone_matrices(pose_bones, out=None):
     """Armature-space 4x4 matrices of pose bones as float32 (B, 4, 4), row-major."""
-    n = len(pose_bones)
-    if out is None:
-        out = np.empty((n, 4, 4), dtype=np.float32)
+    if out is None:  # len() walks the whole bone list in 3.4: callers per frame pass `out`
+        out = np.empty((len(pose_bones), 4, 4), dtype=np.float32)
     pose_bones.foreach_get("matrix", out.reshape(-1))
     # foreach_get yields Blender's column-major matrix layout.
     return out.transpose(0, 2, 1)

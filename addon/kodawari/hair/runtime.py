@@ -157,6 +157,9 @@ class ArmatureRuntime:
         self.matrices = np.zeros((self.bone_count, 16), np.float32)
         self.rotations = np.empty((self.bone_count, 4), np.float32)
         self.held = np.empty((self.bone_count, 4), np.float32)  # rotations a pose holds now
+        # Evaluated matrices before and after a pass (_write_evaluated, _was_evaluated).
+        self.matrices_before = np.empty((self.bone_count, 4, 4), np.float32)
+        self.matrices_after = np.empty((self.bone_count, 4, 4), np.float32)
         # (depsgraph, frame, changed bones, their matrices) after _write_evaluated, until checked.
         self.pending = None
         # The solver reads only the matrices of parents, reference bones and colliders, and
@@ -416,7 +419,7 @@ class ArmatureRuntime:
             changed = np.any(self.held != self.rotations, axis=1)
         elif not changed.any():
             return  # evaluate() checks after the evaluation that the copy holds them
-        before = bulk.pose_bone_matrices(pose_bones)
+        before = bulk.pose_bone_matrices(pose_bones, self.matrices_before)
         bulk.set_pose_rotations(pose_bones, self.rotations)
         self.pending = (depsgraph.as_pointer(), frame, changed, before)
 
@@ -432,7 +435,7 @@ class ArmatureRuntime:
         if pending[0] != depsgraph.as_pointer() or pending[1] != frame:
             return False
         _, _, changed, before = pending
-        after = bulk.pose_bone_matrices(pose_bones)
+        after = bulk.pose_bone_matrices(pose_bones, self.matrices_after)
         return bool(np.all(np.any(after[changed] != before[changed], axis=(1, 2))))
 
     @property
