@@ -115,10 +115,16 @@ class _FirstPass:
     the frame shows (before any second evaluation the add-on may ask for)."""
 
     def __init__(self, obj):
-        self.obj, self.shown = obj, {}
+        self.obj, self.shown, self.rotations = obj, {}, {}
 
     def __call__(self, scene, depsgraph=None):
         evaluated = self.obj.evaluated_get(depsgraph)
+        self.rotations[scene.frame_current] = np.array(
+            [
+                tuple(evaluated.pose.bones[pb.name].rotation_quaternion)
+                for pb in chain_bones(self.obj, "Ahoge")
+            ]
+        )
         self.shown[scene.frame_current] = np.array(
             [
                 tuple(evaluated.pose.bones[pb.name].matrix.to_quaternion())
@@ -277,3 +283,48 @@ def test_predicted_bones_are_where_blender_evaluates_them_for_every_inherit_mode
         bad = np.abs(matrices - blender).max(axis=1)
         assert bad.max() < 2e-6, f"frame {frame}: bones off by {bad}"
         np.testing.assert_allclose(world, np.array(evaluated.matrix_world), atol=1e-6)
+
+
+def test_view_keys_under_a_moving_camera_aimed_by_a_constraint_are_predicted(empty_scene):
+    """A camera that flies round on its own keys and is aimed by Track To (the usual set-up):
+    its position is what its keys say, so a rig with view keys is still predicted, and it
+    gives the hair of the post-evaluation path."""
+    from hair_rig import pose_curl
+
+    def run(predicting):
+        from kodawari.hair import runtime
+
+        bpy.ops.wm.read_homefile(use_empty=True, use_factory_startup=True)
+        scene = bpy.context.scene
+        obj = _rig(scene)
+        bpy.ops.object.mode_set(mode="POSE")
+        camera = scene.camera
+        pose_curl(obj, "Ahoge", "X", 60.0)
+        assert bpy.ops.kodawari.rod_key_view(source="CAMERA", influence=1.0) == {"FINISHED"}
+        pose_curl(obj, "Ahoge", "X", 0.0)
+        bpy.ops.object.mode_set(mode="OBJECT")
+        aim = camera.constraints.new("TRACK_TO")
+        aim.target = obj
+        for frame, location in ((1, (0, -4, 1.7)), (15, (4, 0, 1.7)), (30, (0, 4, 1.7))):
+            camera.location = location
+            camera.keyframe_insert("location", frame=frame)
+        original = runtime.ArmatureRuntime._predict
+        if not predicting:
+            runtime.ArmatureRuntime._predict = lambda *args: False
+        first = _FirstPass(obj)
+        bpy.app.handlers.frame_change_post.append(first)  # runs after the add-on's handler
+        try:
+            seen = _play(scene, obj, FRAMES)
+        finally:
+            runtime.ArmatureRuntime._predict = original
+            bpy.app.handlers.frame_change_post.remove(first)
+        return seen, obj, first
+
+    predicted, obj, first = run(predicting=True)
+    for frame in FRAMES[1:]:  # Blender's first evaluation of each new frame showed its hair
+        np.testing.assert_array_equal(
+            first.rotations[frame], predicted[frame][1], err_msg=f"frame {frame}"
+        )
+    reference, _, _ = run(predicting=False)
+    assert np.abs(reference[30][0] - reference[1][0]).max() > 0.05, "the view should bend it"
+    _assert_same(predicted, reference, atol=1e-5)

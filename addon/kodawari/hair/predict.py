@@ -90,13 +90,20 @@ def _evaluated_curves(id_block, what):
     ]
 
 
-class ObjectMotion:
-    """An object's world matrix from its own transform channels (no parent, no constraints)."""
+# Constraints that turn an object without moving it: a camera aimed by one still has the
+# position its own channels give (the rods read only the camera's position).
+_AIMING = {"TRACK_TO", "DAMPED_TRACK", "LOCKED_TRACK"}
 
-    def __init__(self, obj, what):
+
+class ObjectMotion:
+    """An object's world matrix from its own transform channels (no parent, no constraints;
+    with position_only, aiming constraints are allowed and only position() is valid)."""
+
+    def __init__(self, obj, what, position_only=False):
         if obj.parent is not None:
             raise Unpredictable(f"{what} has a parent")
-        if len(obj.constraints):
+        allowed = _AIMING if position_only else set()
+        if any(c.type not in allowed for c in obj.constraints if c.enabled):
             raise Unpredictable(f"{what} has constraints")
         if getattr(obj, "rigid_body", None) is not None:
             raise Unpredictable(f"{what} is a rigid body")
@@ -232,7 +239,7 @@ class PosePredictor:
         key = camera.as_pointer()
         if key not in self._cameras:
             try:
-                self._cameras[key] = ObjectMotion(camera, "the camera")
+                self._cameras[key] = ObjectMotion(camera, "the camera", position_only=True)
             except Unpredictable:
                 self._cameras[key] = None
         motion = self._cameras[key]
@@ -285,8 +292,9 @@ def close(predicted, actual):
 class Prediction:
     """A frame solved before the pass from predicted inputs, until evaluate() checks it."""
 
-    def __init__(self, frame, previous, matrices, armature, camera, gravity, rotations):
-        self.frame, self.previous = frame, previous
+    def __init__(self, frame, previous, matrices, armature, camera, gravity, rotations, view):
+        """view: whether a rod has view keys (else the camera's position changes nothing)."""
+        self.frame, self.previous, self.view = frame, previous, view
         self.matrices, self.armature, self.camera, self.gravity = (
             matrices,
             armature,
@@ -302,7 +310,7 @@ class Prediction:
         if not close(self.armature, armature):
             return "the armature was not where its action put it"
         if (camera is None) != (self.camera is None) or (
-            camera is not None and not close(self.camera, camera)
+            self.view and camera is not None and not close(self.camera, camera)
         ):
             return "the camera was not where its action put it"
         if not close(self.gravity, gravity):

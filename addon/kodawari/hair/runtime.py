@@ -172,6 +172,12 @@ class ArmatureRuntime:
                 read.update((index[parent.name], index[reference.name]))
         read.update(index[c.bone] for c in colliders)
         self.input_bones = sorted(read)  # what a prediction must know (predict.py)
+        self.view_keys = any(
+            k.condition == "VIEW"
+            for i, rod in enumerate(settings.rods)
+            if i in self.rod_slots
+            for k in rod.keys
+        )
         self.written_bones = sorted(set(rod_bones))
         self.predictor = None  # built at the first new frame (predict.PosePredictor)
         self.prediction_off = None  # why this rig's frames are not predicted, once known
@@ -332,10 +338,12 @@ class ArmatureRuntime:
         time = scene.frame_current_final
         camera = active_camera(scene, frame)
         camera_position = None
-        if camera is not None:
+        if camera is not None and self.view_keys:
             camera_position = self.predictor.camera_position(camera, time)
             if camera_position is None:
                 return False  # a camera moved by more than its own action: this frame only
+        elif camera is not None:  # no view keys: the camera's position changes nothing
+            camera_position = np.array(camera.matrix_world.translation, np.float64)
         try:
             matrices, armature_matrix = self.predictor.predict(time)
         except (predict.Unpredictable, ValueError) as exc:
@@ -356,7 +364,14 @@ class ArmatureRuntime:
             self.rotations,
         )
         self.predicted = predict.Prediction(
-            frame, previous, matrices, armature_matrix, camera_position, gravity, self.rotations
+            frame,
+            previous,
+            matrices,
+            armature_matrix,
+            camera_position,
+            gravity,
+            self.rotations,
+            self.view_keys,
         )
         self.status = "" if camera is not None else NO_CAMERA
         return True
