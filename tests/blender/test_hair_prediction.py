@@ -328,3 +328,62 @@ def test_view_keys_under_a_moving_camera_aimed_by_a_constraint_are_predicted(emp
     reference, _, _ = run(predicting=False)
     assert np.abs(reference[30][0] - reference[1][0]).max() > 0.05, "the view should bend it"
     _assert_same(predicted, reference, atol=1e-5)
+
+
+def _add_ik_arm(obj, scene, chain_count, parent="Root"):
+    """An arm of two bones under `parent` whose hand an IK constraint pulls to an empty."""
+    bpy.context.view_layer.objects.active = obj
+    bpy.ops.object.mode_set(mode="EDIT")
+    bones = obj.data.edit_bones
+    upper = bones.new("Arm.Upper")
+    upper.head, upper.tail, upper.parent = (0.2, 0, 1.4), (0.5, 0, 1.4), bones[parent]
+    lower = bones.new("Arm.Lower")
+    lower.head, lower.tail, lower.parent = (0.5, 0, 1.4), (0.8, 0, 1.4), upper
+    lower.use_connect = True
+    bpy.ops.object.mode_set(mode="POSE")
+    target = bpy.data.objects.new("HandTarget", None)
+    scene.collection.objects.link(target)
+    for frame, location in ((1, (0.6, 0.2, 1.2)), (20, (0.4, -0.3, 1.6))):
+        target.location = location
+        target.keyframe_insert("location", frame=frame)
+    ik = obj.pose.bones["Arm.Lower"].constraints.new("IK")
+    ik.target, ik.chain_count = target, chain_count
+    bpy.ops.object.mode_set(mode="OBJECT")
+
+
+def test_an_ik_arm_elsewhere_in_the_rig_keeps_the_hair_predicted(empty_scene):
+    """Constraints that cannot reach the head (an IK arm beside it) leave the rig predicted;
+    an IK chain that reaches the head's ancestors does not."""
+    from kodawari.hair import predict
+
+    def run(predicting):
+        from kodawari.hair import runtime
+
+        bpy.ops.wm.read_homefile(use_empty=True, use_factory_startup=True)
+        scene = bpy.context.scene
+        obj = _rig(scene)
+        _add_ik_arm(obj, scene, chain_count=2)
+        original = runtime.ArmatureRuntime._predict
+        if not predicting:
+            runtime.ArmatureRuntime._predict = lambda *args: False
+        first = _FirstPass(obj)
+        bpy.app.handlers.frame_change_post.append(first)  # runs after the add-on's handler
+        try:
+            seen = _play(scene, obj, FRAMES)
+        finally:
+            runtime.ArmatureRuntime._predict = original
+            bpy.app.handlers.frame_change_post.remove(first)
+        return seen, obj, first
+
+    predicted, obj, first = run(predicting=True)
+    for frame in FRAMES[1:]:  # Blender's first evaluation of each new frame showed its hair
+        np.testing.assert_array_equal(
+            first.rotations[frame], predicted[frame][1], err_msg=f"frame {frame}"
+        )
+    reference, obj, _ = run(predicting=False)
+    _assert_same(predicted, reference, atol=1e-5)
+    # The same arm whose IK chain runs to the root (through Root, the head's parent).
+    obj.pose.bones["Arm.Lower"].constraints[0].chain_count = 0
+    rt = _runtime(obj)
+    with pytest.raises(predict.Unpredictable):
+        predict.PosePredictor(obj, rt.input_bones, rt.written_bones)

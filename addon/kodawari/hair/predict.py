@@ -170,9 +170,6 @@ class PosePredictor:
         ):
             raise Unpredictable("the armature data is animated")
         self.motion = ObjectMotion(obj, "the armature")
-        # Any constraint can move a bone the rods read (an IK chain reaches its ancestors).
-        if any(len(pb.constraints) for pb in pose_bones):
-            raise Unpredictable("a bone has constraints")
         names = [pb.name for pb in pose_bones]
         index = {name: i for i, name in enumerate(names)}
         # The input bones and their ancestors, parents first.
@@ -182,6 +179,7 @@ class PosePredictor:
             while bone is not None and index[bone.name] not in needed:
                 needed.add(index[bone.name])
                 bone = bone.parent
+        _refuse_constraints(pose_bones, index, needed)
         order = sorted(needed, key=lambda i: (_depth(pose_bones[i]), i))
         position = {b: k for k, b in enumerate(order)}
         self.bones = [pose_bones[i] for i in order]
@@ -268,6 +266,33 @@ class PosePredictor:
         )
         matrices = pose[self.rows].reshape(-1, 4, 4).transpose(0, 2, 1).reshape(-1, 16)
         return matrices.astype(np.float32), self.motion.matrix(time)
+
+
+def _refuse_constraints(pose_bones, index, needed):
+    """Raises when a constraint can move one of the `needed` bones (the rods' inputs and their
+    ancestors): a constraint on one of them, or an IK or Spline IK chain reaching one of them
+    from a bone below (chain length 0: to the root). Constraints elsewhere (an IK leg, a
+    constrained prop) move only their own bones and those below."""
+    for pb in pose_bones:
+        constraints = pb.constraints
+        if not len(constraints):
+            continue
+        if index[pb.name] in needed:
+            raise Unpredictable(f"bone '{pb.name}' has constraints")
+        for con in constraints:
+            if con.type not in ("IK", "SPLINE_IK"):
+                continue
+            # chain_count bones from the owner up (0: to the root); the owner is not needed.
+            length = con.chain_count or len(pose_bones)
+            bone = pb.parent
+            for _ in range(length - 1):
+                if bone is None:
+                    break
+                if index[bone.name] in needed:
+                    raise Unpredictable(
+                        f"the {con.type} chain of '{pb.name}' reaches '{bone.name}'"
+                    )
+                bone = bone.parent
 
 
 def _matrix(matrix):
