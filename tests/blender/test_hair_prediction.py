@@ -352,8 +352,8 @@ def _add_ik_arm(obj, scene, chain_count, parent="Root"):
 
 
 def test_an_ik_arm_elsewhere_in_the_rig_keeps_the_hair_predicted(empty_scene):
-    """Constraints that cannot reach the head (an IK arm beside it) leave the rig predicted;
-    an IK chain that reaches the head's ancestors does not."""
+    """Constraints and drivers that cannot reach the head (an IK arm beside it, a driver on the
+    arm) leave the rig predicted; an IK chain that reaches the head's ancestors does not."""
     from kodawari.hair import predict
 
     def run(predicting):
@@ -363,6 +363,9 @@ def test_an_ik_arm_elsewhere_in_the_rig_keeps_the_hair_predicted(empty_scene):
         scene = bpy.context.scene
         obj = _rig(scene)
         _add_ik_arm(obj, scene, chain_count=2)
+        # A driver elsewhere in the rig (the arm's scale) moves nothing the rods read.
+        driver = obj.driver_add('pose.bones["Arm.Upper"].scale', 0).driver
+        driver.type, driver.expression = "SCRIPTED", "1.1"
         original = runtime.ArmatureRuntime._predict
         if not predicting:
             runtime.ArmatureRuntime._predict = lambda *args: False

@@ -70,13 +70,11 @@ def _rotation_property(mode):
 
 
 def _evaluated_curves(id_block, what):
-    """The F-curves Blender applies to id_block at any frame, when it applies nothing else:
-    the action alone (no drivers, no NLA, full influence, replace)."""
+    """The F-curves Blender applies to id_block at any frame, when the action alone animates
+    it (no NLA, full influence, replace); drivers are checked by _refuse_drivers."""
     anim = id_block.animation_data
     if anim is None:
         return []
-    if len(anim.drivers):
-        raise Unpredictable(f"{what} has drivers")
     if len(anim.nla_tracks) or anim.use_tweak_mode:
         raise Unpredictable(f"{what} uses the NLA")
     if anim.action is None:
@@ -88,6 +86,24 @@ def _evaluated_curves(id_block, what):
         for fc in fcurves.action_fcurves(anim.action, id_block)
         if not fc.mute and fc.is_valid and not (fc.group is not None and fc.group.mute)
     ]
+
+
+def _refuse_drivers(id_block, what, bones=None):
+    """Raises when a driver of id_block can move what the rods read: the object's own
+    transform (or rotation mode), or any property of the pose bones named in `bones`. Drivers
+    of other bones and of custom properties move nothing the rods read."""
+    anim = id_block.animation_data
+    if anim is None:
+        return
+    for driver in anim.drivers:
+        if driver.mute:
+            continue
+        match = _BONE_PATH.match(driver.data_path)
+        if match is not None:
+            if bones is not None and _unescape(match.group(1)) in bones:
+                raise Unpredictable(f"{what} has a driver on {driver.data_path}")
+        elif driver.data_path in _OBJECT_CHANNELS + _OBJECT_DELTAS + ("rotation_mode",):
+            raise Unpredictable(f"{what} has a driver on {driver.data_path}")
 
 
 # Constraints that turn an object without moving it: a camera aimed by one still has the
@@ -107,6 +123,7 @@ class ObjectMotion:
             raise Unpredictable(f"{what} has constraints")
         if getattr(obj, "rigid_body", None) is not None:
             raise Unpredictable(f"{what} is a rigid body")
+        _refuse_drivers(obj, what)
         self.obj = obj
         self.curves = []  # (property, index, fcurve)
         for fc in _evaluated_curves(obj, what):
@@ -180,6 +197,9 @@ class PosePredictor:
                 needed.add(index[bone.name])
                 bone = bone.parent
         _refuse_constraints(pose_bones, index, needed)
+        _refuse_drivers(
+            obj, "the armature", {names[i] for i in needed} | {names[i] for i in written_bones}
+        )
         order = sorted(needed, key=lambda i: (_depth(pose_bones[i]), i))
         position = {b: k for k, b in enumerate(order)}
         self.bones = [pose_bones[i] for i in order]
