@@ -326,6 +326,8 @@ class ArmatureRuntime:
         """Solves the frame after the last simulated one from inputs predicted before Blender
         evaluates it (predict.py); evaluate() checks them against Blender's after the pass.
         False (nothing changed) when this rig's or this frame's inputs cannot be predicted."""
+        if self.predicted is not None:
+            return False  # an earlier prediction was never checked: evaluate() sorts it out
         previous = self._previous_frame(frame)
         if previous != frame - 1 or self.prediction_off is not None or scene.frame_subframe:
             return False
