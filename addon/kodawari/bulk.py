@@ -164,8 +164,8 @@ class PoseRotationView:
         """A view of pose.bones[indices]' rotations, or None where the layout is not confirmed
         (checked on the first, middle and last of them) or the channels lie too far apart."""
         indices = np.asarray(indices, np.int64)
-        if not len(indices) or bpy.app.version >= (5, 1, 0):
-            return None
+        if not len(indices) or bpy.app.version >= (5, 1, 0) or pose.id_data.library:
+            return None  # linked data is not written behind RNA's back
         pose_bones = list(pose.bones)  # one walk of the channel list
         samples = {int(indices[0]), int(indices[len(indices) // 2]), int(indices[-1])}
         offsets = {_quat_offset(pose_bones[i]) for i in samples}
