@@ -63,9 +63,8 @@ def vertex_group_weights(obj, group_name):
 
 def pose_bone_matrices(pose_bones, out=None):
     """Armature-space 4x4 matrices of pose bones as float32 (B, 4, 4), row-major."""
-    n = len(pose_bones)
-    if out is None:
-        out = np.empty((n, 4, 4), dtype=np.float32)
+    if out is None:  # len() walks the whole bone list in 3.4: callers per frame pass `out`
+        out = np.empty((len(pose_bones), 4, 4), dtype=np.float32)
     pose_bones.foreach_get("matrix", out.reshape(-1))
     # foreach_get yields Blender's column-major matrix layout.
     return out.transpose(0, 2, 1)
@@ -87,6 +86,125 @@ def set_pose_rotations(pose_bones, rotations):
     """Writes float32 (B, 4) into every pose bone's rotation_quaternion (see POSE_WRITE_TAGS);
     the caller tags what must be evaluated again."""
     pose_bones.foreach_set("rotation_quaternion", rotations.reshape(-1))
+
+
+# Pose-bone rotations without RNA, for Blender 4.x, where a foreach_set on the original pose
+# runs the RNA update: it tags the armature object and Blender then copies the whole object
+# (every pose channel) in the coming evaluation, 4.5-8.4x a bare evaluation at 160-16,000 bones
+# (docs/algorithms.md §3.7). A bPoseChannel (DNA_action_types.h) keeps
+#   loc[3], size[3], eul[3], quat[4], rotAxis[3], rotAngle
+# one after the other (2.8 through 5.0). The offset of that run is found by matching those 17
+# floats against RNA on a few channels; a view is refused (None) when they disagree.
+# Searched from the channel's start; within the struct (loc[0] is at byte 252 in 4.5 and 5.0).
+_POSE_CHANNEL_SEARCH_BYTES = 512
+_POSE_CHANNEL_QUAT = 9  # floats from loc[0] to quat[0]
+_POSE_VIEW_MAX_SPAN = 1 << 36  # bytes between the first and last channel a view may cover
+
+
+def _pose_channel_floats(pose_bone):
+    """The 17 floats of loc, size, eul, quat, rotAxis, rotAngle as RNA gives them."""
+    angle, *axis = pose_bone.rotation_axis_angle
+    values = (
+        tuple(pose_bone.location)
+        + tuple(pose_bone.scale)
+        + tuple(pose_bone.rotation_euler)
+        + tuple(pose_bone.rotation_quaternion)
+        + tuple(axis)
+        + (angle,)
+    )
+    return np.array(values, np.float32)
+
+
+def _quat_offset(pose_bone):
+    """Byte offset of quat[0] in this bone's bPoseChannel, or None."""
+    import ctypes
+
+    address = pose_bone.as_pointer()
+    if not address:
+        return None
+    memory = np.frombuffer(ctypes.string_at(address, _POSE_CHANNEL_SEARCH_BYTES), np.float32)
+    want = _pose_channel_floats(pose_bone)
+    windows = np.lib.stride_tricks.sliding_window_view(memory, len(want))
+    found = np.flatnonzero(np.all(windows == want, axis=1))
+    # The first match: a later one may be the next channel in memory (a bone at rest looks
+    # like any other); the offsets of three channels must agree (PoseRotationView.create).
+    return None if not len(found) else int(found[0] + _POSE_CHANNEL_QUAT) * 4
+
+
+class PoseRotationView:
+    """rotation_quaternion of some original pose bones, read and written in Blender's memory
+    without RNA (no update runs, nothing is tagged: the caller writes the evaluated copy too,
+    or tags). Built once per armature runtime; valid while the pose's channels are the ones it
+    was built on. `current` checks that from the pose's channel list (bPose starts with the
+    ListBase chanbase {first, last}; a bone added, even with another removed, appends a new
+    channel), and the caller compares a read with RNA's before writing."""
+
+    def __init__(self, indices, offset, addresses, pose_address, first, last, names):
+        import ctypes
+
+        base = int(addresses.min())
+        span = int(addresses.max()) - base + offset + 16
+        self.indices = indices
+        self.pose = (pose_address, first, last)
+        self.names = names  # of the first and last bone, for agrees()
+        memory = (ctypes.c_float * (span // 4)).from_address(base)
+        self.memory = np.frombuffer(memory, np.float32)
+        self.index = ((addresses - base + offset) // 4).astype(np.int64)[:, None] + np.arange(4)
+
+    @staticmethod
+    def _chanbase(pose):
+        import ctypes
+
+        address = pose.as_pointer()
+        first, last = (ctypes.c_void_p * 2).from_address(address)
+        return address, first, last
+
+    @classmethod
+    def create(cls, pose, indices):
+        """A view of pose.bones[indices]' rotations, or None where the layout is not confirmed
+        (checked on the first, middle and last of them) or the channels lie too far apart."""
+        indices = np.asarray(indices, np.int64)
+        if not len(indices) or bpy.app.version >= (5, 1, 0) or pose.id_data.library:
+            return None  # linked data is not written behind RNA's back
+        pose_bones = list(pose.bones)  # one walk of the channel list
+        samples = {int(indices[0]), int(indices[len(indices) // 2]), int(indices[-1])}
+        offsets = {_quat_offset(pose_bones[i]) for i in samples}
+        if len(offsets) != 1 or None in offsets:
+            return None
+        offset = offsets.pop()
+        every = np.array([pb.as_pointer() for pb in pose_bones], np.int64)
+        addresses = every[indices]
+        if addresses.min() <= 0 or addresses.max() - addresses.min() > _POSE_VIEW_MAX_SPAN:
+            return None
+        chanbase = cls._chanbase(pose)
+        if chanbase[1:] != (int(every[0]), int(every[-1])):
+            return None
+        names = (pose_bones[int(indices[0])].name, pose_bones[int(indices[-1])].name)
+        return cls(indices, offset, addresses, *chanbase, names)
+
+    def current(self, pose):
+        """False once the pose or its channel list changed (a bone added or removed)."""
+        return self._chanbase(pose) == self.pose
+
+    def agrees(self, pose):
+        """True when the first and last bone's rotations read here are RNA's (a name lookup is
+        hashed, an index one walks the list)."""
+        view = self.memory[self.index[[0, -1]]]
+        for row, name in zip(view, self.names):
+            pose_bone = pose.bones.get(name)
+            if pose_bone is None or tuple(row) != tuple(
+                np.float32(c) for c in pose_bone.rotation_quaternion
+            ):
+                return False
+        return True
+
+    def read(self):
+        """(N, 4) float32 copy of the rotations."""
+        return self.memory[self.index]
+
+    def write(self, rotations):
+        """rotations (B, 4) float32 for every bone; the view's bones are written."""
+        self.memory[self.index] = rotations[self.indices]
 
 
 # Shape key data without RNA. A KeyBlock keeps its positions in one float array;

@@ -24,4 +24,5 @@ void bind_swim(pybind11::module_& m);
 void bind_ffd(pybind11::module_& m);
 void bind_rod(pybind11::module_& m);
 void bind_gait(pybind11::module_& m);
+void bind_pose(pybind11::module_& m);
 }  // namespace kodawari::bind

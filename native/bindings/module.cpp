@@ -17,4 +17,5 @@ PYBIND11_MODULE(kodawari_native, m) {
   kodawari::bind::bind_ffd(m);
   kodawari::bind::bind_rod(m);
   kodawari::bind::bind_gait(m);
+  kodawari::bind::bind_pose(m);
 }

@@ -6,8 +6,13 @@ and 16,000 chain bones). Per frame, every side gets what a viewport does: `scene
 then the depsgraph evaluates whatever the frame handlers tagged.
 
   kodawari      the add-on's live hair (every chain a rod, 4 substeps per frame), frames played
-                for the first time: Blender's evaluation, our handler (read, solve, write),
-                Blender's second evaluation of the armature our write asks for
+                for the first time: the head's pose predicted from its action, the frame solved
+                and written before Blender evaluates it (frame_change_pre), Blender's evaluation,
+                the prediction checked against it (frame_change_post); one evaluation
+  kodawari_post the same frames solved after Blender's evaluation instead (prediction off, the
+                path of rigs whose parents a constraint, driver or NLA moves): Blender's
+                evaluation, our handler (read, solve, write), the second evaluation our write
+                asks for
   bare          the same rig with the hair switched off: Blender's own evaluation, the floor
   wiggle2_port  a same-process port of Wiggle 2's algorithm (see wiggle2_port.py: Wiggle 2
                 itself cannot be installed on this machine), every chain bone's tail wiggling
@@ -43,7 +48,8 @@ BONE_LENGTH = 0.02
 # chain bones -> (chains, frames per round for kodawari and bare, frames per round for the port)
 SIZES = {160: (10, 12, 6), 1_600: (100, 8, 3), 16_000: (1000, 4, 1)}
 SIDES = ("kodawari", "bare", "wiggle2_port")  # each also measured for peak memory
-EXTRA_SIDES = ("kodawari_cached", "bare_retag")  # timed only: their memory is kodawari's / bare's
+# timed only: their memory is kodawari's / bare's
+EXTRA_SIDES = ("kodawari_cached", "kodawari_post", "bare_retag")
 
 
 def build_rig(scene, chain_count):
@@ -85,6 +91,13 @@ def build_rig(scene, chain_count):
     return obj
 
 
+def _no_prediction(self, obj, scene, frame):
+    return False  # every new frame solved after Blender's evaluation
+
+
+_PREDICT = []  # the add-on's own ArmatureRuntime._predict, once imported
+
+
 def chain_bones(obj):
     return [pb for pb in obj.pose.bones if pb.name != "Head"]
 
@@ -93,11 +106,23 @@ class Sides:
     """Switches the rig between the three sides."""
 
     def __init__(self, scene, obj):
+        from kodawari.hair import runtime
+
+        if not _PREDICT:
+            _PREDICT.append(runtime.ArmatureRuntime._predict)
         self.scene, self.obj = scene, obj
         self.wiggle = wiggle2_port.WigglePort(scene, obj, chain_bones(obj))
 
     def use(self, side):
-        self.obj.kodawari_hair.enabled = side in ("kodawari", "kodawari_cached")
+        from kodawari.hair import runtime
+
+        self.obj.kodawari_hair.enabled = side in ("kodawari", "kodawari_cached", "kodawari_post")
+        if side == "kodawari_post":
+            runtime.ArmatureRuntime._predict = _no_prediction
+        elif "_predict" in vars(runtime.ArmatureRuntime) and (
+            runtime.ArmatureRuntime._predict is _no_prediction
+        ):
+            runtime.ArmatureRuntime._predict = _PREDICT[0]
         if side == "wiggle2_port":
             self.wiggle.install()
         else:
@@ -201,9 +226,10 @@ def measure_size(bones, chain_count, frames_ours, frames_port):
         side: list(range(2, (frames_port if side == "wiggle2_port" else frames_ours) + 2))
         for side in SIDES
     }
-    frames["kodawari_cached"] = frames["bare_retag"] = frames["kodawari"]
+    for side in EXTRA_SIDES:
+        frames[side] = frames["kodawari"]
     players = {side: sides.player(side, frames[side]) for side in SIDES + EXTRA_SIDES}
-    players["kodawari_untagged"] = untagged(sides.player("kodawari", frames["kodawari"]))
+    players["kodawari_untagged"] = untagged(sides.player("kodawari_post", frames["kodawari"]))
     rows = benchlib.Rounds().run(players)
     split = rows.pop("kodawari_untagged")
     solver = solver_alone(scene, obj, frames["kodawari"])
@@ -218,14 +244,42 @@ def measure_size(bones, chain_count, frames_ours, frames_port):
         rows[side]["bones"] = bones
         rows[side]["frames_per_round"] = len(frames[side])
     solver["untagged_ms_median"] = split["ms_median"]
-    return {"bones": bones, "rows": rows, "solver": solver, "setup_s": round(setup, 1)}
+    predicted = predicted_frames(sides.player("kodawari", frames["kodawari"]))
+    return {
+        "bones": bones,
+        "rows": rows,
+        "solver": solver,
+        "setup_s": round(setup, 1),
+        "predicted": predicted,
+        "new_frames": len(frames["kodawari"]),
+    }
+
+
+def predicted_frames(play):
+    """How many of the kodawari side's new frames were solved before Blender's evaluation (their
+    predicted inputs confirmed after it), in one more untimed round."""
+    from kodawari.hair import predict
+
+    confirmed = []
+    mismatch = predict.Prediction.mismatch
+
+    def spy(self, *args):
+        wrong = mismatch(self, *args)
+        confirmed.append(wrong is None)
+        return wrong
+
+    predict.Prediction.mismatch = spy
+    try:
+        play(0)
+    finally:
+        predict.Prediction.mismatch = mismatch
+    return sum(confirmed)
 
 
 def untagged(play):
-    """The live hair without its write (Blender then never shows the hair): measured only to split
-    the whole frame into Blender's first evaluation + our handler and what the write costs (in
-    3.4 the update tag; in 4.5 and 5.0 the foreach_set tags by itself): a copy-on-write of the
-    whole armature object, evaluated again."""
+    """The post-evaluation path without its write (Blender then never shows the hair): measured
+    only to split that path's whole frame into Blender's first evaluation + our handler and what
+    the write costs: a copy-on-write of the whole armature object, evaluated again."""
     from kodawari.hair import runtime
 
     def run(round_):
@@ -253,7 +307,7 @@ def main():
         print(f"  {bones:>6,} chain bones ({chain_count} chains, set-up {size['setup_s']} s):")
         for side in SIDES + EXTRA_SIDES:
             row = rows[side]
-            if side in ("kodawari", "kodawari_cached", "bare_retag"):
+            if side in ("kodawari", "kodawari_cached", "kodawari_post", "bare_retag"):
                 ratio = f"  this / bare {row['ms_median'] / bare['ms_median']:5.2f}x"
             elif side == "bare":
                 ratio = ""
@@ -270,10 +324,12 @@ def main():
             f" = {s['handler_ms_min'] * 1e3 / bones:.2f} us/bone; native step {s['step_ms_min']:.2f} /"
             f" {s['step_ms_median']:.2f} ms"
         )
-        second = ours["ms_median"] - s["untagged_ms_median"]
+        post = rows["kodawari_post"]
+        second = post["ms_median"] - s["untagged_ms_median"]
         print(
-            f"    whole frame split: first evaluation + handler (no write) {s['untagged_ms_median']:.2f} ms, the write "
-            f"and the second evaluation it asks for {second:.2f} ms = {second / bare['ms_median']:.2f}x the bare evaluation"
+            f"    post-evaluation path split: first evaluation + handler (no write) {s['untagged_ms_median']:.2f} ms, "
+            f"the write and the second evaluation it asks for {second:.2f} ms = {second / bare['ms_median']:.2f}x "
+            f"the bare evaluation; predicted / post-evaluation path {ours['ms_median'] / post['ms_median']:.2f}x"
         )
         floor = rows["bare_retag"]["ms_median"]
         print(
@@ -281,6 +337,7 @@ def main():
             f"{floor - bare['ms_median']:.2f} ms = {(floor - bare['ms_median']) / bare['ms_median']:.2f}x the "
             f"bare evaluation; kodawari / bare_retag {ours['ms_median'] / floor:.2f}x"
         )
+        print(f"    kodawari predicted {size['predicted']} of {size['new_frames']} new frames")
         benchlib.record("hair", results)
 
 

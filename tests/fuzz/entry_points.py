@@ -651,6 +651,19 @@ TARGETS = [
         kn.gait_forward_kinematics,
         examples=60,
     ),
+    Target(
+        "pose_forward_kinematics",
+        lambda: {
+            "parents": np.array([-1, 0, 1], np.int32),
+            "rest": np.tile(np.eye(4).reshape(-1), (3, 1)),
+            "channels": np.tile([0.0, 0.1, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 1.0, 1.0], (3, 1)),
+            "rotation_modes": np.array([0, 1, -1], np.int32),
+            "inherit_rotation": np.array([1, 0, 1], np.int32),
+            "inherit_scale": np.array([0, 1, 3], np.int32),  # AVERAGE under a hinge
+        },
+        kn.pose_forward_kinematics,
+        examples=60,
+    ),
 ]
 
 

@@ -16,7 +16,7 @@ pose it renders.
 import numpy as np
 
 from .. import bulk, native, problems
-from . import chains
+from . import chains, predict
 
 # The solver state of the last evaluated frame is saved into the .blend (save_pre)
 # so that a reloaded file continues exactly where it stopped.
@@ -157,6 +157,9 @@ class ArmatureRuntime:
         self.matrices = np.zeros((self.bone_count, 16), np.float32)
         self.rotations = np.empty((self.bone_count, 4), np.float32)
         self.held = np.empty((self.bone_count, 4), np.float32)  # rotations a pose holds now
+        # Evaluated matrices before and after a pass (_write_evaluated, _was_evaluated).
+        self.matrices_before = np.empty((self.bone_count, 4, 4), np.float32)
+        self.matrices_after = np.empty((self.bone_count, 4, 4), np.float32)
         # (depsgraph, frame, changed bones, their matrices) after _write_evaluated, until checked.
         self.pending = None
         # The solver reads only the matrices of parents, reference bones and colliders, and
@@ -168,6 +171,18 @@ class ArmatureRuntime:
                 parent, reference, _chain = chains.resolve_rod(obj, rod)
                 read.update((index[parent.name], index[reference.name]))
         read.update(index[c.bone] for c in colliders)
+        self.input_bones = sorted(read)  # what a prediction must know (predict.py)
+        self.view_keys = any(
+            k.condition == "VIEW"
+            for i, rod in enumerate(settings.rods)
+            if i in self.rod_slots
+            for k in rod.keys
+        )
+        self.written_bones = sorted(set(rod_bones))
+        self.predictor = None  # built at the first new frame (predict.PosePredictor)
+        self.prediction_off = None  # why this rig's frames are not predicted, once known
+        self.predicted = None  # the prediction made before the pass, until checked after it
+        self.rotation_view = None  # bulk.PoseRotationView once built, False when refused
         self.matrix_bones = (
             sorted(read) if len(read) * SPARSE_READ_RATIO <= self.bone_count else None
         )
@@ -204,7 +219,7 @@ class ArmatureRuntime:
             camera_position = np.array(
                 _evaluated(camera, depsgraph).matrix_world.translation, np.float64
             )
-        gravity = np.array(scene.gravity if scene.use_gravity else (0.0, 0.0, 0.0), np.float64)
+        gravity = _gravity(scene)
         armature_matrix = np.array([tuple(row) for row in evaluated.matrix_world], np.float64)
         return armature_matrix, camera_position, gravity
 
@@ -218,9 +233,17 @@ class ArmatureRuntime:
         the whole object and a second evaluation, §3.7) only when the pose `depsgraph` has just
         evaluated was not already made from them, e.g. a frame show_cached() wrote before the
         evaluation or a chain at rest. Without a depsgraph the tag is unconditional."""
-        if not self._holds(obj.pose.bones):
+        view = self._original_view(obj)
+        if view is not None:
+            holds = np.array_equal(view.read(), self.rotations[view.indices])
+        else:
+            holds = self._holds(obj.pose.bones)
+        if not holds:
             self.pending = None
-            bulk.set_pose_rotations(obj.pose.bones, self.rotations)
+            if view is not None:
+                view.write(self.rotations)
+            else:
+                bulk.set_pose_rotations(obj.pose.bones, self.rotations)
             _tag(obj)
             return
         evaluated = _evaluated(obj, depsgraph)
@@ -234,16 +257,29 @@ class ArmatureRuntime:
             _tag(obj)
 
     def show_cached(self, obj, scene, frame):
-        """Before Blender evaluates `frame` (frame_change_pre): a frame the cache holds needs no
-        evaluated input, so its rotations go into the armature now and Blender evaluates the
-        frame once, with them, instead of twice (§3.7). Returns whether the frame was cached."""
+        """Before Blender evaluates `frame` (frame_change_pre): a frame the cache holds, or a new
+        frame whose inputs can be predicted (_predict), needs no evaluated input, so its rotations
+        go into the armature now and Blender evaluates the frame once, with them, instead of
+        twice (§3.7). Returns whether the frame was written."""
         if frame <= scene.frame_start or self.system.rod_count == 0:
             return False
         pose_bones = obj.pose.bones
         self._read_other_rotations(pose_bones)
-        if not self.system.recall_frame(frame, self.rotations, load_state=self.last_frame != frame):
+        cached = self.system.recall_frame(
+            frame, self.rotations, load_state=self.last_frame != frame
+        )
+        if not (cached or self._predict(obj, scene, frame)):
             return False
         self.last_frame = frame
+        view = self._original_view(obj)
+        if view is not None:
+            # The rod bones' rotations in Blender's memory (no RNA: nothing tagged, no update).
+            changed = np.zeros(self.bone_count, bool)
+            changed[view.indices] = np.any(view.read() != self.rotations[view.indices], axis=1)
+            if changed.any():
+                view.write(self.rotations)
+            self._write_evaluated(obj, frame, changed)
+            return True
         if not self._holds(pose_bones):
             bulk.set_pose_rotations(pose_bones, self.rotations)
             if bulk.POSE_WRITE_TAGS:
@@ -255,11 +291,132 @@ class ArmatureRuntime:
         self._write_evaluated(obj, frame)
         return True
 
-    def _write_evaluated(self, obj, frame):
+    def _original_view(self, obj):
+        """The rod bones' rotations in the original pose's memory (bulk.PoseRotationView), or
+        None where it is refused or out of date: then RNA. Without RNA, a write runs no update,
+        so in Blender 4.x it no longer has Blender copy the whole armature in the coming
+        evaluation, and in every Blender it skips a pass over every pose bone (§3.7). Checked
+        against the pose's channel list and against RNA (first and last rod bone) before use."""
+        view = self.rotation_view
+        if view is False:
+            return None
+        pose = obj.pose
+        if pose is None:
+            return None
+        if view is None:
+            view = self.rotation_view = (
+                bulk.PoseRotationView.create(pose, self.written_bones) or False
+            )
+            if view is False:
+                return None
+        if not (view.current(pose) and view.agrees(pose)):
+            self.rotation_view = False  # the memory is not what RNA shows: RNA from now on
+            return None
+        return view
+
+    def _previous_frame(self, frame):
+        """The frame `frame` steps on from: the solver's own state when it was the last one
+        simulated (the budget may already have dropped it from the cache), else the latest
+        cached one."""
+        if self.last_frame == frame - 1:
+            return self.last_frame
+        return self.system.latest_cached_frame_before(frame)
+
+    def _predict(self, obj, scene, frame):
+        """Solves the frame after the last simulated one from inputs predicted before Blender
+        evaluates it (predict.py); evaluate() checks them against Blender's after the pass.
+        False (nothing changed) when this rig's or this frame's inputs cannot be predicted."""
+        if self.predicted is not None:
+            return False  # an earlier prediction was never checked: evaluate() sorts it out
+        previous = self._previous_frame(frame)
+        if previous != frame - 1 or self.prediction_off is not None or scene.frame_subframe:
+            return False
+        if self.predictor is None:
+            try:
+                self.predictor = predict.PosePredictor(obj, self.input_bones, self.written_bones)
+            except predict.Unpredictable as exc:
+                self.prediction_off = str(exc)
+                return False
+        time = scene.frame_current_final
+        camera = active_camera(scene, frame)
+        camera_position = None
+        if camera is not None and self.view_keys:
+            camera_position = self.predictor.camera_position(camera, time)
+            if camera_position is None:
+                return False  # a camera moved by more than its own action: this frame only
+        elif camera is not None:  # no view keys: the camera's position changes nothing
+            camera_position = np.array(camera.matrix_world.translation, np.float64)
+        try:
+            matrices, armature_matrix = self.predictor.predict(time)
+        except (predict.Unpredictable, ValueError) as exc:
+            self.prediction_off = str(exc)
+            return False
+        gravity = _gravity(scene)
+        self.matrices[self.input_bones] = matrices
+        fps = scene.render.fps / scene.render.fps_base
+        if self.last_frame != previous:
+            self.system.recall_frame(previous)
+        self.system.step(
+            self.matrices,
+            armature_matrix,
+            camera_position,
+            gravity,
+            frame / fps,
+            (frame - previous) / fps,
+            self.rotations,
+        )
+        self.predicted = predict.Prediction(
+            frame,
+            previous,
+            matrices,
+            armature_matrix,
+            camera_position,
+            gravity,
+            self.rotations,
+            self.view_keys,
+        )
+        self.status = "" if camera is not None else NO_CAMERA
+        return True
+
+    def _confirm(self, prediction, obj, scene, frame, depsgraph):
+        """After the pass that follows a prediction: the frame stands when Blender's inputs are
+        the predicted ones; otherwise it is solved again from Blender's (the state before the
+        step restored, written and tagged: a second pass) and this rig's frames are no longer
+        predicted until playback restarts. Returns False when the pass was of another frame."""
+        if prediction.frame != frame or self.last_frame != frame:
+            self.system.recall_frame(prediction.previous)  # undo the step nobody evaluated
+            self.last_frame = prediction.previous
+            return False
+        armature_matrix, camera, gravity = self._inputs(obj, scene, frame, depsgraph)
+        rods = self.rod_bones
+        self.rotations[rods] = prediction.rotations[rods]
+        wrong = prediction.mismatch(
+            self.matrices[self.input_bones], armature_matrix, camera, gravity
+        )
+        if wrong is not None:
+            self.prediction_off = wrong
+            fps = scene.render.fps / scene.render.fps_base
+            self.system.recall_frame(prediction.previous)
+            self.system.step(
+                self.matrices,
+                armature_matrix,
+                camera,
+                gravity,
+                frame / fps,
+                (frame - prediction.previous) / fps,
+                self.rotations,
+            )
+        self.system.store_frame(frame, self.rotations)
+        self._write(obj, depsgraph)
+        return True
+
+    def _write_evaluated(self, obj, frame, changed=None):
         """Writes the rotations into the viewport's evaluated armature too: when the frame change
         re-evaluates the pose (an animated parent), it does so with them and without copying the
         whole object again. Whether it did is checked after the evaluation (_was_evaluated);
-        without an evaluated copy to write, the armature is tagged (copied, evaluated once)."""
+        without an evaluated copy to write, the armature is tagged (copied, evaluated once).
+        `changed`: the bones whose rotation the original pose just changed (the evaluated copy
+        held what the original held), instead of reading the copy's rotations."""
         import bpy
 
         if self.pending is not None:  # an earlier write nobody evaluated: let Blender copy afresh
@@ -273,10 +430,13 @@ class ArmatureRuntime:
             _tag(obj)
             return
         pose_bones = evaluated.pose.bones
-        if self._holds(pose_bones):
-            return
-        changed = np.any(self.held != self.rotations, axis=1)
-        before = bulk.pose_bone_matrices(pose_bones)
+        if changed is None:
+            if self._holds(pose_bones):
+                return
+            changed = np.any(self.held != self.rotations, axis=1)
+        elif not changed.any():
+            return  # evaluate() checks after the evaluation that the copy holds them
+        before = bulk.pose_bone_matrices(pose_bones, self.matrices_before)
         bulk.set_pose_rotations(pose_bones, self.rotations)
         self.pending = (depsgraph.as_pointer(), frame, changed, before)
 
@@ -292,7 +452,7 @@ class ArmatureRuntime:
         if pending[0] != depsgraph.as_pointer() or pending[1] != frame:
             return False
         _, _, changed, before = pending
-        after = bulk.pose_bone_matrices(pose_bones)
+        after = bulk.pose_bone_matrices(pose_bones, self.matrices_after)
         return bool(np.all(np.any(after[changed] != before[changed], axis=(1, 2))))
 
     @property
@@ -308,6 +468,9 @@ class ArmatureRuntime:
         if self.system.rod_count == 0:
             self.status = ""
             return
+        prediction, self.predicted = self.predicted, None
+        if prediction is not None and self._confirm(prediction, obj, scene, frame, depsgraph):
+            return
         if frame > scene.frame_start:
             self._read_other_rotations(_evaluated(obj, depsgraph).pose.bones)
             if self.system.recall_frame(frame, self.rotations, load_state=self.last_frame != frame):
@@ -315,12 +478,7 @@ class ArmatureRuntime:
                 self.status = "" if active_camera(scene, frame) is not None else NO_CAMERA
                 self._write(obj, depsgraph)
                 return
-        # The frame before, from the solver's own state when it was the last one simulated (the
-        # budget may already have dropped it from the cache), else the latest cached one.
-        if self.last_frame == frame - 1:
-            previous = self.last_frame
-        else:
-            previous = self.system.latest_cached_frame_before(frame)
+        previous = self._previous_frame(frame)
         if (
             frame > scene.frame_start
             and (previous is None or previous < frame - 1)
@@ -333,6 +491,7 @@ class ArmatureRuntime:
         fps = scene.render.fps / scene.render.fps_base
         armature_matrix, camera, gravity = self._inputs(obj, scene, frame, depsgraph)
         if frame <= scene.frame_start or previous is None:
+            self.predictor, self.prediction_off = None, None  # looked at afresh from the start
             self.system.clear_cache()
             self.system.reset(
                 self.matrices, armature_matrix, camera, gravity, frame / fps, self.rotations
@@ -358,6 +517,10 @@ class ArmatureRuntime:
         if slot is None or self.last_frame is None:
             return None
         return self.system.weights(slot)
+
+
+def _gravity(scene):
+    return np.array(scene.gravity if scene.use_gravity else (0.0, 0.0, 0.0), np.float64)
 
 
 def _evaluated(obj, depsgraph):
@@ -446,9 +609,8 @@ def evaluate_scene(scene, depsgraph=None):
 
 
 def show_cached_frames(scene):
-    """frame_change_pre: writes the frames the caches hold before Blender evaluates them."""
-    if _replaying:
-        return
+    """frame_change_pre: writes the frames the caches hold, and new frames whose inputs can be
+    predicted (also while a jump replays the skipped frames), before Blender evaluates them."""
     for obj in hair_armatures(scene):
         rt = get(obj, build=False)
         if rt is None:
