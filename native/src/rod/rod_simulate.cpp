@@ -32,6 +32,7 @@ struct SimulationScratch {
   std::vector<Mat3, Eigen::aligned_allocator<Mat3>> orientation_terms;
   QuatList orientation_quats;
   Vec3List displacement;
+  BudgetScratch budget;  // the energy budget's work arrays
 };
 
 SimulationScratch& simulation_scratch() {
@@ -126,6 +127,14 @@ void RodSystem::simulate(std::size_t r, const FrameInput& input, const std::vect
   const Real frame_time = steps > 0 ? Real(steps) * base_dt : Real(1);
   const Vec3 anchor_velocity = (anchor_end - anchor_start) / frame_time;
 
+  // Energy budget (docs/algorithms.md §3.3, "Energy budget"): every 1/24 s of simulated time
+  // (`substeps` base substeps, whatever the frame rate) the state may hold no more energy,
+  // relative to the root's motion, than when that window began. Wind is an input the budget
+  // does not account for: no budget while it blows.
+  const bool budgeted = p.wind.squaredNorm() == 0;
+  if (!budgeted) s.window.steps = -1;
+  const Real kappa = shape_stiffness(p);
+
   w.orientation_terms.resize(count);
   w.orientation_quats.resize(count);
   w.displacement.resize(count);
@@ -133,6 +142,11 @@ void RodSystem::simulate(std::size_t r, const FrameInput& input, const std::vect
   Vec3* x = s.x.data();
   Quat* q = s.q.data();
   for (long step = 1; step <= steps; ++step) {
+    if (budgeted && s.window.steps < 0) {
+      Real gravitational = 0, shape = 0;
+      chain_potential(count, x, q, w.x_rest.data(), w.q_rest.data(), ellipsoid, kappa, gravity, gravitational, shape);
+      open_energy_window(count, s, x[1], q[0], shape);
+    }
     // No joint may move more than kMaxTravel bone lengths relative to the root in one
     // substep: beyond that the length projection's linearisation no longer sees the motion it
     // corrects (its corrections add up along the chain: on long chains of short bones a
@@ -283,6 +297,12 @@ void RodSystem::simulate(std::size_t r, const FrameInput& input, const std::vect
       }
       for (std::size_t j = 2; j < count; ++j) s.v[j] = (x[j] - s.prev_x[j]) * inverse_dt;
       for (std::size_t j = 1; j < count; ++j) s.omega[j] = angular_velocity(s.prev_q[j], q[j], dt);
+    }
+    if (budgeted && ++s.window.steps >= p.substeps) {
+      // The window closes with the root where this substep left it (x[1], q[0]).
+      const Real shape = close_energy_window(count, s, w.x_rest.data(), w.q_rest.data(), w.lengths.data(), ellipsoid,
+                                             kappa, gravity, x[1], q[0], Real(p.substeps) * base_dt, w.budget);
+      open_energy_window(count, s, x[1], q[0], shape);
     }
   }
   s.anchor_position = anchor_end;

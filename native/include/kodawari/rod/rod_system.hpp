@@ -78,6 +78,23 @@ struct FrameInput {
   Real frame_dt = 1.0 / 24.0;   // seconds since the previous frame
 };
 
+// The energy budget's current window of 1/24 s of simulated time (docs/algorithms.md §3.3):
+// the state when it opened and the moments of its motion that the budget needs. Part of the
+// saved state, so a frame recalled from the cache steps on exactly as played.
+struct EnergyWindow {
+  int steps = -1;            // base substeps since it opened; -1: none open
+  Vec3 origin = Vec3::Zero();          // the root's pose when it opened
+  Quat rotation = Quat::Identity();
+  Vec3List x;                // particles when it opened
+  QuatList q;
+  Real speed2 = 0;           // Σ |v_j|² (dynamic joints)
+  Vec3 momentum = Vec3::Zero();  // Σ v_j
+  Vec3 angular = Vec3::Zero();   // Σ (x_j - origin) × v_j
+  Real spin2 = 0;            // Σ |ω_j|² (every particle but the ghost)
+  Vec3 spin = Vec3::Zero();      // Σ ω_j
+  Real shape = 0;            // the shape-matching energy
+};
+
 struct RodState {
   Vec3List x, v, prev_x;     // particles (n + 2)
   QuatList q, prev_q;
@@ -89,6 +106,7 @@ struct RodState {
   Vec3 reference_position = Vec3::Zero();  // world, for the speed condition
   Real time_accumulator = 0.0;
   Real speed = 0.0;
+  EnergyWindow window;
   bool initialised = false;
 };
 
