@@ -105,14 +105,18 @@ struct BudgetScratch {
   Vec3List x_carried, x_trial;
   QuatList q_carried, q_trial;
 };
-// Opens a window on the state now (root at origin, rotation; `shape` its shape-matching energy).
-void open_energy_window(std::size_t count, RodState& s, const Vec3& origin, const Quat& rotation, Real shape);
+// Opens a window on the state now (root at origin, rotation; `shape` its shape-matching energy;
+// gravity the solver's, asleep as EnergyWindow::asleep).
+void open_energy_window(std::size_t count, RodState& s, const Vec3& origin, const Quat& rotation, Real shape,
+                        const Vec3& gravity, bool asleep);
 // Closes the window `duration` seconds after it opened, the root now at origin, rotation:
 // brings the state back within the budget if it ended above it. Returns the shape-matching
-// energy of the state kept (to open the next window with).
+// energy of the state kept (to open the next window with); `rests` when it put the state back
+// where the window began with the root still (the next window may sleep).
 Real close_energy_window(std::size_t count, RodState& s, const Vec3* x_rest, const Quat* q_rest, const Real* lengths,
                          Real e, Real kappa, const Vec3& g, const Vec3& origin, const Quat& rotation, Real duration,
-                         BudgetScratch& scratch);
+                         const std::vector<Collider>& colliders, Real radius, BudgetScratch& scratch,
+                         bool& rests);
 
 // Rest particles in the anchor frame (see the header for the particle layout).
 void rest_particles(const ChainGeometry& g, const QuatList& rest, Vec3List& x_rest, QuatList& q_rest);

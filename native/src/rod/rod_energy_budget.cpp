@@ -92,7 +92,8 @@ Real level_by_newton(std::size_t count, RodState& s, const Vec3* x_rest, const Q
 // potential of the state kept.
 Real hold_potential(std::size_t count, RodState& s, const Vec3* x_rest, const Quat* q_rest, const Real* lengths, Real e,
                     Real kappa, const Vec3& g, const EnergyBudget& budget, const Vec3List& x_carried,
-                    const QuatList& q_carried, Vec3List& x_trial, QuatList& q_trial) {
+                    const QuatList& q_carried, Vec3List& x_trial, QuatList& q_trial, bool& reverted) {
+  reverted = false;
   const RigidMotion& frame = budget.motion;
   x_trial.resize(count);
   q_trial.resize(count);
@@ -156,14 +157,18 @@ Real hold_potential(std::size_t count, RodState& s, const Vec3* x_rest, const Qu
   }
   for (std::size_t j = 2; j < count; ++j) s.x[j] = x_trial[j];
   for (std::size_t j = 1; j < count; ++j) s.q[j] = q_trial[j];
+  reverted = inside == 0;
   return kept;
 }
 
 }  // namespace
 
-void open_energy_window(std::size_t count, RodState& s, const Vec3& origin, const Quat& rotation, Real shape) {
+void open_energy_window(std::size_t count, RodState& s, const Vec3& origin, const Quat& rotation, Real shape,
+                        const Vec3& gravity, bool asleep) {
   EnergyWindow& w = s.window;
   w.steps = 0;
+  w.asleep = asleep;
+  w.gravity = gravity;
   w.origin = origin;
   w.rotation = rotation;
   w.x.assign(s.x.begin(), s.x.end());
@@ -187,7 +192,9 @@ void open_energy_window(std::size_t count, RodState& s, const Vec3& origin, cons
 
 Real close_energy_window(std::size_t count, RodState& s, const Vec3* x_rest, const Quat* q_rest, const Real* lengths,
                          Real e, Real kappa, const Vec3& g, const Vec3& origin, const Quat& rotation, Real duration,
-                         BudgetScratch& scratch) {
+                         const std::vector<Collider>& colliders, Real radius, BudgetScratch& scratch,
+                         bool& rests) {
+  rests = false;
   const EnergyWindow& w = s.window;
   // The root's rigid motion over the window: velocity V and spin Ω, constant.
   Quat turn = (rotation * w.rotation.conjugate()).normalized();
@@ -233,11 +240,30 @@ Real close_energy_window(std::size_t count, RodState& s, const Vec3* x_rest, con
   if (now_kinetic + now_gravitational + shape <= budget.energy) return shape;
 
   Real potential = now_gravitational + shape + centrifugal(count, s.x.data(), frame);
-  bool moved = false;
+  bool moved = false, reverted = false;
   if (potential > budget.energy) {
     potential = hold_potential(count, s, x_rest, q_rest, lengths, e, kappa, g, budget, scratch.x_carried,
-                               scratch.q_carried, scratch.x_trial, scratch.q_trial);
+                               scratch.q_carried, scratch.x_trial, scratch.q_trial, reverted);
     moved = true;
+    // Put back where the window began with the root still: the chain rests (EnergyWindow::asleep).
+    rests = reverted && budget.motion.velocity.squaredNorm() == 0 && budget.motion.spin.squaredNorm() == 0;
+    // A move towards the rest shape may enter a collider: out again, joint by joint from the
+    // root on its bone length, as the solver's last pass does (contact is exempt from the
+    // budget, like the solver's own push-out).
+    if (!colliders.empty()) {
+      bool pushed = false;
+      for (std::size_t j = 2; j < count; ++j) {
+        for (int pass = 0; pass < 4; ++pass) {
+          const Vec3 d = s.x[j] - s.x[j - 1];
+          const Real len = d.norm();
+          if (pass > 0 && len > 1e-12) s.x[j] = s.x[j - 1] + d * (lengths[j - 2] / len);
+          if (!push_out_of_colliders(s.x[j], colliders, radius)) break;
+          pushed = true;
+          rests = false;
+        }
+      }
+      if (pushed) potential = trial_potential(count, s.x.data(), s.q.data(), x_rest, q_rest, e, kappa, g, frame);
+    }
   }
   // Scale the joints' motion relative to the root so the kinetic energy fills what is left.
   // After a move of the positions the solver's velocities no longer belong to them (the step

@@ -1,6 +1,7 @@
 // One frame of one rod (docs/algorithms.md §3.3): substeps of oriented-particle shape
 // matching (Müller & Chentanez 2011, "Solid simulation with oriented particles") with
-// exact inextensibility (rod/inextensibility.hpp, Goldenthal et al. 2007).
+// exact inextensibility (rod/inextensibility.hpp, Goldenthal et al. 2007), held to an energy
+// budget every 1/24 s (rod_energy_budget.cpp).
 #include "kodawari/rod/rod_system.hpp"
 
 #include <algorithm>
@@ -145,7 +146,26 @@ void RodSystem::simulate(std::size_t r, const FrameInput& input, const std::vect
     if (budgeted && s.window.steps < 0) {
       Real gravitational = 0, shape = 0;
       chain_potential(count, x, q, w.x_rest.data(), w.q_rest.data(), ellipsoid, kappa, gravity, gravitational, shape);
-      open_energy_window(count, s, x[1], q[0], shape);
+      open_energy_window(count, s, x[1], q[0], shape, gravity, false);
+    }
+    if (budgeted && s.window.asleep) {
+      // Asleep (EnergyWindow::asleep): skip this substep while nothing that could move the chain
+      // has changed; any change wakes it, the window going on from the state it began with.
+      const Real f = Real(step) / Real(steps);
+      const Vec3 anchor = anchor_start + f * (anchor_end - anchor_start);
+      const Quat anchor_rotation = anchor_start_rotation.slerp(f, anchor_end_rotation).normalized();
+      bool still = (anchor - s.window.origin).squaredNorm() < Real(1e-24) &&
+                   std::abs(std::abs(anchor_rotation.dot(s.window.rotation)) - 1) < Real(1e-12) &&
+                   gravity == s.window.gravity;
+      for (std::size_t j = 2; j < count && still && !colliders.empty(); ++j) {
+        Vec3 probe = x[j];
+        still = !push_out_of_colliders(probe, colliders, p.radius);
+      }
+      if (still) {
+        if (++s.window.steps >= p.substeps) s.window.steps = 0;  // the next window sleeps on
+        continue;
+      }
+      s.window.asleep = false;
     }
     // No joint may move more than kMaxTravel bone lengths relative to the root in one
     // substep: beyond that the length projection's linearisation no longer sees the motion it
@@ -300,9 +320,11 @@ void RodSystem::simulate(std::size_t r, const FrameInput& input, const std::vect
     }
     if (budgeted && ++s.window.steps >= p.substeps) {
       // The window closes with the root where this substep left it (x[1], q[0]).
+      bool rests = false;
       const Real shape = close_energy_window(count, s, w.x_rest.data(), w.q_rest.data(), w.lengths.data(), ellipsoid,
-                                             kappa, gravity, x[1], q[0], Real(p.substeps) * base_dt, w.budget);
-      open_energy_window(count, s, x[1], q[0], shape);
+                                             kappa, gravity, x[1], q[0], Real(p.substeps) * base_dt, colliders, p.radius,
+                                             w.budget, rests);
+      open_energy_window(count, s, x[1], q[0], shape, gravity, rests);
     }
   }
   s.anchor_position = anchor_end;

@@ -6,7 +6,9 @@
 //   predict x and q from v, ω, gravity, wind (GLM-noise gusts), damping;
 //   `iterations` x { shape matching over each particle's neighbourhood {j-1, j, j+1},
 //                   PBD distance constraints, collider push-out };
-//   exact-length pass from the root, v = Δx/dt, ω from q·q_old⁻¹.
+//   exact-length pass from the root, v = Δx/dt, ω from q·q_old⁻¹;
+//   every 1/24 s the energy budget: no energy gained but what the root's motion brings, and a
+//   chain at rest sleeps (rod_energy_budget.cpp, docs/algorithms.md §3.3).
 // Particles: 0 = a kinematic "ghost" behind the root fixed in the parent's frame (it
 // gives the root bone its rest direction relative to the head), 1 = the root joint
 // (kinematic position, dynamic orientation), 2..n = the following joints, n+1 = the tip.
@@ -93,6 +95,12 @@ struct EnergyWindow {
   Real spin2 = 0;            // Σ |ω_j|² (every particle but the ghost)
   Vec3 spin = Vec3::Zero();      // Σ ω_j
   Real shape = 0;            // the shape-matching energy
+  // The last window ended by putting the state back where it began, the root still: the chain
+  // rests where its energy allows and stepping it again would only repeat that. Asleep, the
+  // substeps are skipped while the root stays put, gravity is unchanged and no collider
+  // reaches a joint (as rigid-body engines put resting bodies to sleep).
+  bool asleep = false;
+  Vec3 gravity = Vec3::Zero();   // when the window opened (armature space, with the rod's factor)
 };
 
 struct RodState {
