@@ -93,7 +93,7 @@ Real chain_kinetic(std::size_t count, const Vec3* x, const Vec3* v, const Vec3* 
 // `turn`, the sum of the orientations R_c q̄_i its groups pull each particle towards (x, y, z, w).
 void chain_potential(std::size_t count, const Vec3* x, const Quat* q, const Vec3* x_rest, const Quat* q_rest, Real e,
                      Real kappa, const Vec3& g, Real& gravitational, Real& shape_matching, Vec3* pull = nullptr,
-                     Eigen::Matrix<Real, 4, 1>* turn = nullptr);
+                     Eigen::Matrix<Real, 4, 1>* turn = nullptr, const Quat* guesses = nullptr);
 
 // The energy budget (rod_energy_budget.cpp, docs/algorithms.md §3.3): the energy a window of
 // 1/24 s may end with, relative to the root's rigid motion over it.
@@ -111,12 +111,13 @@ void open_energy_window(std::size_t count, RodState& s, const Vec3& origin, cons
                         const Vec3& gravity, bool asleep);
 // Closes the window `duration` seconds after it opened, the root now at origin, rotation:
 // brings the state back within the budget if it ended above it. Returns the shape-matching
-// energy of the state kept (to open the next window with); `rests` when it put the state back
+// energy of the state kept (to open the next window with); `guesses` (may be null): each group's
+// rotation from the solver's last iteration, to start its fit from; `rests` when it put the state back
 // where the window began with the root still (the next window may sleep).
 Real close_energy_window(std::size_t count, RodState& s, const Vec3* x_rest, const Quat* q_rest, const Real* lengths,
                          Real e, Real kappa, const Vec3& g, const Vec3& origin, const Quat& rotation, Real duration,
-                         const std::vector<Collider>& colliders, Real radius, BudgetScratch& scratch,
-                         bool& rests);
+                         const std::vector<Collider>& colliders, Real radius, const Quat* guesses,
+                         BudgetScratch& scratch, bool& rests);
 
 // Rest particles in the anchor frame (see the header for the particle layout).
 void rest_particles(const ChainGeometry& g, const QuatList& rest, Vec3List& x_rest, QuatList& q_rest);

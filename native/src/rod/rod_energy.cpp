@@ -43,7 +43,7 @@ Real chain_kinetic(std::size_t count, const Vec3* x, const Vec3* v, const Vec3* 
 
 void chain_potential(std::size_t count, const Vec3* x, const Quat* q, const Vec3* x_rest, const Quat* q_rest, Real e,
                      Real kappa, const Vec3& g, Real& gravitational, Real& shape_matching, Vec3* pull,
-                     Eigen::Matrix<Real, 4, 1>* turn) {
+                     Eigen::Matrix<Real, 4, 1>* turn, const Quat* guesses) {
   gravitational = 0;
   if (pull) {
     for (std::size_t j = 0; j < count; ++j) pull[j].setZero();
@@ -84,7 +84,9 @@ void chain_potential(std::size_t count, const Vec3* x, const Quat* q, const Vec3
       A += wi * e * E[i];
     }
     Mat3 R;
-    if (!polar_rotation(A, R)) R = extract_rotation(A, q[c] * q_rest[c].conjugate(), 64).toRotationMatrix();
+    if (!(guesses && refine_rotation(A, guesses[c], R)) && !polar_rotation(A, R)) {
+      R = extract_rotation(A, q[c] * q_rest[c].conjugate(), 64).toRotationMatrix();
+    }
     Real u = 0;
     for (std::size_t i = lo; i <= hi; ++i) {
       const Real wi = i <= 1 ? kKinematicWeight : Real(1);

@@ -192,8 +192,8 @@ void open_energy_window(std::size_t count, RodState& s, const Vec3& origin, cons
 
 Real close_energy_window(std::size_t count, RodState& s, const Vec3* x_rest, const Quat* q_rest, const Real* lengths,
                          Real e, Real kappa, const Vec3& g, const Vec3& origin, const Quat& rotation, Real duration,
-                         const std::vector<Collider>& colliders, Real radius, BudgetScratch& scratch,
-                         bool& rests) {
+                         const std::vector<Collider>& colliders, Real radius, const Quat* guesses,
+                         BudgetScratch& scratch, bool& rests) {
   rests = false;
   const EnergyWindow& w = s.window;
   // The root's rigid motion over the window: velocity V and spin Ω, constant.
@@ -235,7 +235,8 @@ Real close_energy_window(std::size_t count, RodState& s, const Vec3* x_rest, con
   // The state now, relative to the same motion.
   const RigidMotion& frame = budget.motion;
   Real now_gravitational = 0, shape = 0;
-  chain_potential(count, s.x.data(), s.q.data(), x_rest, q_rest, e, kappa, g, now_gravitational, shape);
+  chain_potential(count, s.x.data(), s.q.data(), x_rest, q_rest, e, kappa, g, now_gravitational, shape, nullptr,
+                  nullptr, guesses);
   const Real now_kinetic = chain_kinetic(count, s.x.data(), s.v.data(), s.omega.data(), e, frame);
   if (now_kinetic + now_gravitational + shape <= budget.energy) return shape;
 

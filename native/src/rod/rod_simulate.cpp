@@ -321,9 +321,12 @@ void RodSystem::simulate(std::size_t r, const FrameInput& input, const std::vect
     if (budgeted && ++s.window.steps >= p.substeps) {
       // The window closes with the root where this substep left it (x[1], q[0]).
       bool rests = false;
+      // Each group's rotation from the last iteration starts the energy's exact fit.
+      w.new_q[0] = q[0];
+      for (std::size_t c = 1; c < count; ++c) w.new_q[c] = w.new_q[c] * w.q_rest_conjugate[c];
       const Real shape = close_energy_window(count, s, w.x_rest.data(), w.q_rest.data(), w.lengths.data(), ellipsoid,
                                              kappa, gravity, x[1], q[0], Real(p.substeps) * base_dt, colliders, p.radius,
-                                             w.budget, rests);
+                                             w.new_q.data(), w.budget, rests);
       open_energy_window(count, s, x[1], q[0], shape, gravity, rests);
     }
   }

@@ -19,6 +19,13 @@ Quat extract_rotation(const Mat3& A, const Quat& guess, int max_iterations = 24)
 // (as a chain group's fit is). False (R untouched) when det A <= 0 or it did not converge.
 bool polar_rotation(const Mat3& A, Mat3& R);
 
+// The same rotation by Newton's method on tr(Rᵀ A) over rotations R = R₀ exp([ω]×), from a
+// guess R near it: ω = (tr S I - S)⁻¹ g with M = R₀ᵀ A, S = sym M, g = (M₂₁ - M₁₂, M₀₂ - M₂₀,
+// M₁₀ - M₀₁). Quadratic from a close guess (a group's rotation from the solver's last
+// iteration): two or three steps where polar_rotation needs four or five inversions. False
+// (R untouched) when it did not converge in `steps`.
+bool refine_rotation(const Mat3& A, const Quat& guess, Mat3& R, int steps = 4);
+
 // PBD distance constraint between a and b with inverse masses wa, wb (inline: the
 // substep loop calls it once per segment).
 inline void project_distance(Vec3& a, Vec3& b, Real wa, Real wb, Real rest_length) {
