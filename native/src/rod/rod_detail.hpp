@@ -106,9 +106,10 @@ struct BudgetScratch {
   QuatList q_carried, q_trial;
 };
 // Opens a window on the state now (root at origin, rotation; `shape` its shape-matching energy;
-// gravity the solver's, asleep as EnergyWindow::asleep).
+// gravity the solver's, asleep as EnergyWindow::asleep), `phase` base substeps into its 1/24 s
+// (0, or where the one it replaces had got to when the rest shape changed).
 void open_energy_window(std::size_t count, RodState& s, const Vec3& origin, const Quat& rotation, Real shape,
-                        const Vec3& gravity, bool asleep);
+                        const Vec3& gravity, bool asleep, int phase);
 // Closes the window `duration` seconds after it opened, the root now at origin, rotation:
 // brings the state back within the budget if it ended above it. Returns the shape-matching
 // energy of the state kept (to open the next window with); `guesses` (may be null): each group's

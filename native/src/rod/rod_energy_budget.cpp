@@ -164,9 +164,11 @@ Real hold_potential(std::size_t count, RodState& s, const Vec3* x_rest, const Qu
 }  // namespace
 
 void open_energy_window(std::size_t count, RodState& s, const Vec3& origin, const Quat& rotation, Real shape,
-                        const Vec3& gravity, bool asleep) {
+                        const Vec3& gravity, bool asleep, int phase) {
   EnergyWindow& w = s.window;
-  w.steps = 0;
+  w.steps = phase;
+  w.first = phase;
+  w.reopen = false;
   w.asleep = asleep;
   w.gravity = gravity;
   w.origin = origin;

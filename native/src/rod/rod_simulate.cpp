@@ -143,10 +143,13 @@ void RodSystem::simulate(std::size_t r, const FrameInput& input, const std::vect
   Vec3* x = s.x.data();
   Quat* q = s.q.data();
   for (long step = 1; step <= steps; ++step) {
-    if (budgeted && s.window.steps < 0) {
+    if (budgeted && (s.window.steps < 0 || s.window.reopen)) {
+      // A new window, or (the rest shape changed: its energy is input) a fresh start of the
+      // current one that still ends where it would have, so windows close at the same simulated
+      // times whatever the frame rate and however often the view changes the rest shape.
       Real gravitational = 0, shape = 0;
       chain_potential(count, x, q, w.x_rest.data(), w.q_rest.data(), ellipsoid, kappa, gravity, gravitational, shape);
-      open_energy_window(count, s, x[1], q[0], shape, gravity, false);
+      open_energy_window(count, s, x[1], q[0], shape, gravity, false, std::max(s.window.steps, 0));
     }
     if (budgeted && s.window.asleep) {
       // Asleep (EnergyWindow::asleep): skip this substep while nothing that could move the chain
@@ -162,7 +165,10 @@ void RodSystem::simulate(std::size_t r, const FrameInput& input, const std::vect
         still = !push_out_of_colliders(probe, colliders, p.radius);
       }
       if (still) {
-        if (++s.window.steps >= p.substeps) s.window.steps = 0;  // the next window sleeps on
+        if (++s.window.steps >= p.substeps) {  // the next window sleeps on
+          s.window.steps = 0;
+          s.window.first = 0;
+        }
         continue;
       }
       s.window.asleep = false;
@@ -325,9 +331,9 @@ void RodSystem::simulate(std::size_t r, const FrameInput& input, const std::vect
       w.new_q[0] = q[0];
       for (std::size_t c = 1; c < count; ++c) w.new_q[c] = w.new_q[c] * w.q_rest_conjugate[c];
       const Real shape = close_energy_window(count, s, w.x_rest.data(), w.q_rest.data(), w.lengths.data(), ellipsoid,
-                                             kappa, gravity, x[1], q[0], Real(p.substeps) * base_dt, colliders, p.radius,
-                                             w.new_q.data(), w.budget, rests);
-      open_energy_window(count, s, x[1], q[0], shape, gravity, rests);
+                                             kappa, gravity, x[1], q[0], Real(p.substeps - s.window.first) * base_dt,
+                                             colliders, p.radius, w.new_q.data(), w.budget, rests);
+      open_energy_window(count, s, x[1], q[0], shape, gravity, rests, 0);
     }
   }
   s.anchor_position = anchor_end;

@@ -34,7 +34,7 @@ struct Reader {
 std::size_t RodSystem::rod_state_size(std::size_t r) const {
   const std::size_t n = rods_[r].bones.size();
   // The energy window: steps, origin, rotation, x and q of every particle, 11 moments and the shape energy.
-  return 1 + (n + 2) * (3 + 3 + 4 + 3) + n * 4 + 3 + 4 + 3 + 2 + weights_[r].size() + 1 + 3 + 4 + (n + 2) * 7 + 11 + 1 + 1 + 3;
+  return 1 + (n + 2) * (3 + 3 + 4 + 3) + n * 4 + 3 + 4 + 3 + 2 + weights_[r].size() + 1 + 3 + 4 + (n + 2) * 7 + 11 + 1 + 1 + 3 + 2;
 }
 
 std::size_t RodSystem::state_size() const {
@@ -78,6 +78,8 @@ void RodSystem::write_rod_state(std::size_t r, Real* out) const {
   w.put(open ? window.shape : Real(0));
   w.put(open && window.asleep ? Real(1) : Real(0));
   w.put(open ? window.gravity : Vec3::Zero());
+  w.put(open ? Real(window.first) : Real(0));
+  w.put(open && window.reopen ? Real(1) : Real(0));
 }
 
 void RodSystem::read_rod_state(std::size_t r, const Real* in) {
@@ -124,6 +126,8 @@ void RodSystem::read_rod_state(std::size_t r, const Real* in) {
   window.shape = rd.real();
   window.asleep = rd.real() != 0;
   window.gravity = rd.vec();
+  window.first = static_cast<int>(rd.real());
+  window.reopen = rd.real() != 0;
   // The rest shape is not stored: it is always the blend of the keys with these weights
   // (begin_frame), recomputed here bit for bit by the same function.
   if (s.initialised) {

@@ -84,7 +84,9 @@ struct FrameInput {
 // the state when it opened and the moments of its motion that the budget needs. Part of the
 // saved state, so a frame recalled from the cache steps on exactly as played.
 struct EnergyWindow {
-  int steps = -1;            // base substeps since it opened; -1: none open
+  int steps = -1;            // base substeps into the current 1/24 s; -1: none open
+  int first = 0;             // `steps` when it opened (later than 0 after a change of rest shape)
+  bool reopen = false;       // the rest shape changed: open again on the state now, same phase
   Vec3 origin = Vec3::Zero();          // the root's pose when it opened
   Quat rotation = Quat::Identity();
   Vec3List x;                // particles when it opened
