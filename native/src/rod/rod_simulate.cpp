@@ -336,6 +336,18 @@ void RodSystem::simulate(std::size_t r, const FrameInput& input, const std::vect
       open_energy_window(count, s, x[1], q[0], shape, gravity, rests, 0);
     }
   }
+  if (budgeted && s.window.steps > s.window.first && !s.window.asleep) {
+    // The frame ends inside a window: what the user sees is held to the budget too. Closed here
+    // and opened again at the same phase, so the next window still ends on the 1/24 s grid.
+    const int phase = s.window.steps;
+    bool rests = false;
+    w.new_q[0] = q[0];
+    for (std::size_t c = 1; c < count; ++c) w.new_q[c] = w.new_q[c] * w.q_rest_conjugate[c];
+    const Real shape = close_energy_window(count, s, w.x_rest.data(), w.q_rest.data(), w.lengths.data(), ellipsoid,
+                                           kappa, gravity, x[1], q[0], Real(phase - s.window.first) * base_dt,
+                                           colliders, p.radius, w.new_q.data(), w.budget, rests);
+    open_energy_window(count, s, x[1], q[0], shape, gravity, false, phase);
+  }
   s.anchor_position = anchor_end;
   s.anchor_rotation = anchor_end_rotation;
   if (steps == 0) {
