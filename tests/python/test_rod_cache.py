@@ -8,7 +8,7 @@ import kodawari_native as kn
 import numpy as np
 
 RODS, BONES = 1000, 16  # 16,000 rod bones
-# 48 MB: about a dozen frames of this system (3.9 MB each since the state also carries the
+# 48 MB: about a dozen frames of this system (4.0 MB each since the state also carries the
 # energy budget's window, docs/algorithms.md §3.3; 2.7 MB before, with a 32 MB budget).
 BUDGET = 48 << 20
 
