@@ -87,7 +87,8 @@ struct RigidMotion {
 Real ellipsoid_term(const ChainGeometry& geometry);
 // Kinetic energy of the dynamic particles relative to `frame` (the Jacobi integral's kinetic
 // part; the plain kinetic energy for a frame at rest).
-Real chain_kinetic(std::size_t count, const Vec3* x, const Vec3* v, const Vec3* omega, Real e, const RigidMotion& frame);
+Real chain_kinetic(std::size_t count, const Vec3* x, const Vec3* v, const Vec3* omega, Real e,
+                   const RigidMotion& frame);
 // Gravitational -Σ g·x_j and shape-matching (κ/3) Σ_c U_c energies of the particles. With
 // `pull`, also Σ_c w_i (g_ci - x_i) per particle (-3/κ times the shape-matching gradient); with
 // `turn`, the sum of the orientations R_c q̄_i its groups pull each particle towards (x, y, z, w).

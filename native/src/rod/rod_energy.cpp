@@ -21,7 +21,8 @@ Real ellipsoid_term(const ChainGeometry& geometry) {
   return mean * mean / 5;  // the ellipsoid term's a²/5: a sphere of radius one segment
 }
 
-Real chain_kinetic(std::size_t count, const Vec3* x, const Vec3* v, const Vec3* omega, Real e, const RigidMotion& frame) {
+Real chain_kinetic(std::size_t count, const Vec3* x, const Vec3* v, const Vec3* omega, Real e,
+                   const RigidMotion& frame) {
   // Unit mass per dynamic joint; each particle's orientation has the inertia 2e of a sphere
   // of radius one segment (½ (2e) ω², the partner of the ellipsoid term below). Relative to
   // the root's rigid motion u(x) = V + Ω × (x - o), with the centrifugal term -½ |Ω × (x - o)|²

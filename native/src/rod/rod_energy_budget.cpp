@@ -45,9 +45,9 @@ void restore_lengths(std::size_t count, Vec3* x, const Real* lengths) {
 
 // The potential (gravity, shape matching and the centrifugal term) of a trial state.
 Real trial_potential(std::size_t count, const Vec3* x, const Quat* q, const Vec3* x_rest, const Quat* q_rest, Real e,
-                     Real kappa, const Vec3& g, const RigidMotion& frame) {
+                     Real kappa, const Vec3& g, const RigidMotion& frame, const Quat* guesses) {
   Real gravitational = 0, shape = 0;
-  chain_potential(count, x, q, x_rest, q_rest, e, kappa, g, gravitational, shape);
+  chain_potential(count, x, q, x_rest, q_rest, e, kappa, g, gravitational, shape, nullptr, nullptr, guesses);
   return gravitational + shape + centrifugal(count, x, frame);
 }
 
@@ -56,9 +56,9 @@ Real trial_potential(std::size_t count, const Vec3* x, const Quat* q, const Vec3
 // ΔV / |∇V|² (Dinev et al. 2018 project onto the energy level along its gradient; positions
 // only), doubled up to three times until it gets there. `pull` as chain_potential fills it.
 // Returns the potential reached, or NaN when it did not get there.
-Real level_by_newton(std::size_t count, RodState& s, const Vec3* x_rest, const Quat* q_rest, const Real* lengths, Real e,
-                     Real kappa, const Vec3& g, Real level, Real excess, const RigidMotion& frame, const Vec3List& pull,
-                     Vec3List& x_trial) {
+Real level_by_newton(std::size_t count, RodState& s, const Vec3* x_rest, const Quat* q_rest, const Real* lengths,
+                     Real e, Real kappa, const Vec3& g, Real level, Real excess, const RigidMotion& frame,
+                     const Vec3List& pull, Vec3List& x_trial, const Quat* guesses) {
   const Real missed = std::numeric_limits<Real>::quiet_NaN();
   thread_local Vec3List gradient;
   gradient.resize(count);
@@ -74,7 +74,7 @@ Real level_by_newton(std::size_t count, RodState& s, const Vec3* x_rest, const Q
     x_trial[1] = s.x[1];
     for (std::size_t j = 2; j < count; ++j) x_trial[j] = s.x[j] - t * gradient[j];
     restore_lengths(count, x_trial.data(), lengths);
-    const Real trial = trial_potential(count, x_trial.data(), s.q.data(), x_rest, q_rest, e, kappa, g, frame);
+    const Real trial = trial_potential(count, x_trial.data(), s.q.data(), x_rest, q_rest, e, kappa, g, frame, guesses);
     if (trial <= level) {
       for (std::size_t j = 2; j < count; ++j) s.x[j] = x_trial[j];
       return trial;
@@ -92,7 +92,8 @@ Real level_by_newton(std::size_t count, RodState& s, const Vec3* x_rest, const Q
 // potential of the state kept.
 Real hold_potential(std::size_t count, RodState& s, const Vec3* x_rest, const Quat* q_rest, const Real* lengths, Real e,
                     Real kappa, const Vec3& g, const EnergyBudget& budget, const Vec3List& x_carried,
-                    const QuatList& q_carried, Vec3List& x_trial, QuatList& q_trial, bool& reverted) {
+                    const QuatList& q_carried, Vec3List& x_trial, QuatList& q_trial, bool& reverted,
+                    const Quat* guesses) {
   reverted = false;
   const RigidMotion& frame = budget.motion;
   x_trial.resize(count);
@@ -103,10 +104,11 @@ Real hold_potential(std::size_t count, RodState& s, const Vec3* x_rest, const Qu
   turn.resize(count);
   Real gravitational = 0, shape = 0;
   chain_potential(count, s.x.data(), s.q.data(), x_rest, q_rest, e, kappa, g, gravitational, shape, pull.data(),
-                  turn.data());
+                  turn.data(), guesses);
   const Real excess = gravitational + shape + centrifugal(count, s.x.data(), frame) - budget.energy;
   const Real levelled =
-      level_by_newton(count, s, x_rest, q_rest, lengths, e, kappa, g, budget.energy, excess, frame, pull, x_trial);
+      level_by_newton(count, s, x_rest, q_rest, lengths, e, kappa, g, budget.energy, excess, frame, pull, x_trial,
+                      guesses);
   if (!std::isnan(levelled)) return levelled;
   const Vec3 sag = g / kappa;
   for (Real phi = Real(1) / 64; phi <= 1; phi *= 2) {
@@ -125,7 +127,8 @@ Real hold_potential(std::size_t count, RodState& s, const Vec3* x_rest, const Qu
       q_trial[j] = unit(Quat((1 - f) * s.q[j].coeffs() + (f / norm) * turn[j]));
     }
     restore_lengths(count, x_trial.data(), lengths);
-    const Real trial = trial_potential(count, x_trial.data(), q_trial.data(), x_rest, q_rest, e, kappa, g, frame);
+    const Real trial =
+        trial_potential(count, x_trial.data(), q_trial.data(), x_rest, q_rest, e, kappa, g, frame, guesses);
     if (trial <= budget.energy) {
       for (std::size_t j = 2; j < count; ++j) s.x[j] = x_trial[j];
       for (std::size_t j = 1; j < count; ++j) s.q[j] = q_trial[j];
@@ -144,7 +147,8 @@ Real hold_potential(std::size_t count, RodState& s, const Vec3* x_rest, const Qu
     }
     for (std::size_t j = 2; j < count; ++j) x_trial[j] = x_carried[j] + f * (s.x[j] - x_carried[j]);
     restore_lengths(count, x_trial.data(), lengths);
-    const Real trial = trial_potential(count, x_trial.data(), q_trial.data(), x_rest, q_rest, e, kappa, g, frame);
+    const Real trial =
+        trial_potential(count, x_trial.data(), q_trial.data(), x_rest, q_rest, e, kappa, g, frame, guesses);
     if (step == kLineSearchSteps) {
       kept = trial;
       break;
@@ -246,7 +250,7 @@ Real close_energy_window(std::size_t count, RodState& s, const Vec3* x_rest, con
   bool moved = false, reverted = false;
   if (potential > budget.energy) {
     potential = hold_potential(count, s, x_rest, q_rest, lengths, e, kappa, g, budget, scratch.x_carried,
-                               scratch.q_carried, scratch.x_trial, scratch.q_trial, reverted);
+                               scratch.q_carried, scratch.x_trial, scratch.q_trial, reverted, guesses);
     moved = true;
     // Put back where the window began with the root still: the chain rests (EnergyWindow::asleep).
     rests = reverted && budget.motion.velocity.squaredNorm() == 0 && budget.motion.spin.squaredNorm() == 0;
@@ -265,7 +269,9 @@ Real close_energy_window(std::size_t count, RodState& s, const Vec3* x_rest, con
           rests = false;
         }
       }
-      if (pushed) potential = trial_potential(count, s.x.data(), s.q.data(), x_rest, q_rest, e, kappa, g, frame);
+      if (pushed) {
+        potential = trial_potential(count, s.x.data(), s.q.data(), x_rest, q_rest, e, kappa, g, frame, guesses);
+      }
     }
   }
   // Scale the joints' motion relative to the root so the kinetic energy fills what is left.
@@ -273,7 +279,9 @@ Real close_energy_window(std::size_t count, RodState& s, const Vec3* x_rest, con
   // they came from was refused): the joints keep only the root's motion. Kept, they re-created
   // the same refused step window after window and stiff strands buzzed at 1-2 cm/s for ever.
   Real relative = 0;
-  for (std::size_t j = 2; j < count; ++j) relative += Real(0.5) * (s.v[j] - carried_velocity(frame, s.x[j])).squaredNorm();
+  for (std::size_t j = 2; j < count; ++j) {
+    relative += Real(0.5) * (s.v[j] - carried_velocity(frame, s.x[j])).squaredNorm();
+  }
   for (std::size_t j = 1; j < count; ++j) relative += e * (s.omega[j] - frame.spin).squaredNorm();
   const Real room = budget.energy - potential;
   const Real scale = moved || !(room > 0 && relative > 0) ? Real(0) : std::min(Real(1), std::sqrt(room / relative));
@@ -282,7 +290,10 @@ Real close_energy_window(std::size_t count, RodState& s, const Vec3* x_rest, con
     s.v[j] = u + scale * (s.v[j] - u);
   }
   for (std::size_t j = 1; j < count; ++j) s.omega[j] = frame.spin + scale * (s.omega[j] - frame.spin);
-  if (moved) chain_potential(count, s.x.data(), s.q.data(), x_rest, q_rest, e, kappa, g, now_gravitational, shape);
+  if (moved) {
+    chain_potential(count, s.x.data(), s.q.data(), x_rest, q_rest, e, kappa, g, now_gravitational, shape, nullptr,
+                    nullptr, guesses);
+  }
   return shape;
 }
 

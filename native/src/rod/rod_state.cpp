@@ -34,7 +34,8 @@ struct Reader {
 std::size_t RodSystem::rod_state_size(std::size_t r) const {
   const std::size_t n = rods_[r].bones.size();
   // The energy window: steps, origin, rotation, x and q of every particle, 11 moments and the shape energy.
-  return 1 + (n + 2) * (3 + 3 + 4 + 3) + n * 4 + 3 + 4 + 3 + 2 + weights_[r].size() + 1 + 3 + 4 + (n + 2) * 7 + 11 + 1 + 1 + 3 + 2;
+  return 1 + (n + 2) * (3 + 3 + 4 + 3) + n * 4 + 3 + 4 + 3 + 2 + weights_[r].size() + 1 + 3 + 4 + (n + 2) * 7 + 11 +
+         1 + 1 + 3 + 2;
 }
 
 std::size_t RodSystem::state_size() const {
