@@ -1,5 +1,6 @@
 // Native cost of the rod solver: 1,000 chains x 16 bones, 4 substeps per frame, the head
-// swaying smoothly (Smooth) or jumping back every second (the solver's worst case).
+// swaying smoothly (Smooth), jumping back every second (the solver's worst case) or still
+// with the hair at rest after 10 s of settling (Still: what a scene of resting hair costs).
 // Reports time per frame and per particle-substep (items = particle-substeps).
 #include <benchmark/benchmark.h>
 
@@ -16,9 +17,12 @@ namespace {
 constexpr int kChains = 1000;
 constexpr int kBones = 16;
 
-// smooth: the head sways on a sine (as characters move); otherwise it jumps back by 0.4 m
-// every 24 frames (a sawtooth: every chain whips, the solver's worst case).
-void run_rods(benchmark::State& state, bool smooth) {
+enum class Head { Smooth, Sawtooth, Still };
+
+// Smooth: the head sways on a sine (as characters move); Sawtooth: it jumps back by 0.4 m
+// every 24 frames (every chain whips, the solver's worst case); Still: it holds still and the
+// chains, horizontal at first, have 240 frames to come to rest before the timing starts.
+void run_rods(benchmark::State& state, Head head) {
   const unsigned threads = static_cast<unsigned>(state.range(0));
   const std::size_t bone_count = 1 + kChains * kBones;
   RodSystem system(bone_count, threads);
@@ -47,9 +51,18 @@ void run_rods(benchmark::State& state, bool smooth) {
   input.camera = Vec3(0, -5, 1.7);
   system.reset(input, rotations.data());
   int frame = 0;
+  if (head == Head::Still) {
+    for (; frame < 240; ++frame) {
+      input.time = (frame + 1) / 24.0;
+      system.step(input, rotations.data());
+    }
+  }
   for (auto _ : state) {
-    matrices[12] = smooth ? 0.2f * static_cast<float>(std::sin(frame * 2.0 * 3.14159265 / 24.0))
-                          : 0.2f * static_cast<float>((frame % 24) - 12) / 12.0f;  // the head sways
+    if (head == Head::Smooth) {
+      matrices[12] = 0.2f * static_cast<float>(std::sin(frame * 2.0 * 3.14159265 / 24.0));  // the head sways
+    } else if (head == Head::Sawtooth) {
+      matrices[12] = 0.2f * static_cast<float>((frame % 24) - 12) / 12.0f;
+    }
     input.time = ++frame / 24.0;
     system.step(input, rotations.data());
     benchmark::DoNotOptimize(rotations.data());
@@ -60,11 +73,13 @@ void run_rods(benchmark::State& state, bool smooth) {
                                                                     benchmark::Counter::kInvert);
 }
 
-void BM_RodSystemStep(benchmark::State& state) { run_rods(state, false); }
-void BM_RodSystemStepSmooth(benchmark::State& state) { run_rods(state, true); }
+void BM_RodSystemStep(benchmark::State& state) { run_rods(state, Head::Sawtooth); }
+void BM_RodSystemStepSmooth(benchmark::State& state) { run_rods(state, Head::Smooth); }
+void BM_RodSystemStepStill(benchmark::State& state) { run_rods(state, Head::Still); }
 
 }  // namespace
 
 BENCHMARK(BM_RodSystemStepSmooth)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_RodSystemStep)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_RodSystemStepStill)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_MAIN();

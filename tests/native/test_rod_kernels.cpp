@@ -49,6 +49,49 @@ TEST(RodKernels, ExtractRotationRecoversARotatedScaledMatrix) {
   EXPECT_LT(q.angularDistance(truth), 1e-6);
 }
 
+// The energy's polar decomposition (docs/algorithms.md §3.3): a rotation times a symmetric
+// positive-definite stretch, far from a rotation (singular values 40:1, as a chain group's fit
+// is mostly its length), gives the rotation back to round-off.
+TEST(RodKernels, PolarRotationRecoversTheRotationOfAStretchedMatrix) {
+  std::mt19937 random(7);
+  std::uniform_real_distribution<Real> unit(-1, 1);
+  for (int trial = 0; trial < 50; ++trial) {
+    const Quat truth = Quat(unit(random), unit(random), unit(random), unit(random)).normalized();
+    const Quat frame = Quat(unit(random), unit(random), unit(random), unit(random)).normalized();
+    const Mat3 stretch = frame.toRotationMatrix() * Vec3(2.0, 0.05, 0.6).asDiagonal() *
+                         frame.toRotationMatrix().transpose();
+    Mat3 R;
+    ASSERT_TRUE(polar_rotation(truth.toRotationMatrix() * stretch, R));
+    EXPECT_LT((R - truth.toRotationMatrix()).norm(), 1e-12);
+  }
+  // A reflection has no rotational part to find: refused, R untouched.
+  Mat3 R = Mat3::Identity();
+  EXPECT_FALSE(polar_rotation(Vec3(1.0, 1.0, -1.0).asDiagonal(), R));
+  EXPECT_EQ(R, Mat3::Identity());
+}
+
+// From a guess 0.2 rad off, Newton's steps on the same fit reach what polar_rotation finds.
+TEST(RodKernels, RefineRotationFromAGuessAgreesWithThePolarDecomposition) {
+  std::mt19937 random(11);
+  std::uniform_real_distribution<Real> unit(-1, 1);
+  for (int trial = 0; trial < 50; ++trial) {
+    const Quat truth = Quat(unit(random), unit(random), unit(random), unit(random)).normalized();
+    const Quat frame = Quat(unit(random), unit(random), unit(random), unit(random)).normalized();
+    const Mat3 A = truth.toRotationMatrix() * frame.toRotationMatrix() * Vec3(1.0, 0.25, 0.24).asDiagonal() *
+                   frame.toRotationMatrix().transpose();
+    const Quat off = truth * Quat(Eigen::AngleAxis<Real>(0.2, Vec3(unit(random), unit(random), 1).normalized()));
+    Mat3 R, reference;
+    ASSERT_TRUE(refine_rotation(A, off, R));
+    ASSERT_TRUE(polar_rotation(A, reference));
+    EXPECT_LT((R - reference).norm(), 1e-9);
+  }
+  // A guess a half turn away is refused (R untouched): the caller falls back to polar_rotation.
+  const Mat3 A = Vec3(1.0, 0.3, 0.2).asDiagonal();
+  Mat3 R = Mat3::Zero();
+  EXPECT_FALSE(refine_rotation(A, Quat(Eigen::AngleAxis<Real>(3.0, Vec3::UnitZ())), R));
+  EXPECT_EQ(R, Mat3::Zero());
+}
+
 TEST(RodKernels, BlendKeepsLengthsAndForwardKinematicsPlacesTheTip) {
   ChainGeometry g;
   g.offsets = {Vec3(0, 0.2, 0), Vec3(0, 0.1, 0), Vec3(0, 0.1, 0)};

@@ -8,7 +8,9 @@ import kodawari_native as kn
 import numpy as np
 
 RODS, BONES = 1000, 16  # 16,000 rod bones
-BUDGET = 32 << 20
+# 48 MB: about a dozen frames of this system (4.0 MB each since the state also carries the
+# energy budget's window, docs/algorithms.md §3.3; 2.7 MB before, with a 32 MB budget).
+BUDGET = 48 << 20
 
 
 def _system():

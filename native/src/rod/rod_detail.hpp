@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "kodawari/rod/rod_system.hpp"
 
@@ -73,6 +74,52 @@ inline Vec3 angular_velocity(const Quat& from, const Quat& to, Real dt) {
   if (dq.w() < 1e-6) return Vec3::Zero();  // a half turn in one substep: no meaningful spin
   return dq.vec() * (2 / (dq.w() * dt));
 }
+
+// The energy of docs/algorithms.md §3.3 (rod_energy.cpp), shared by RodSystem::energy and the
+// solver's per-frame energy budget so both measure exactly the same quantity.
+// The kinematic root's rigid motion over a frame: velocity V at `origin`, spin Ω.
+struct RigidMotion {
+  Vec3 origin = Vec3::Zero();
+  Vec3 velocity = Vec3::Zero();
+  Vec3 spin = Vec3::Zero();
+};
+// a²/5 of the ellipsoid term, a the mean segment length.
+Real ellipsoid_term(const ChainGeometry& geometry);
+// Kinetic energy of the dynamic particles relative to `frame` (the Jacobi integral's kinetic
+// part; the plain kinetic energy for a frame at rest).
+Real chain_kinetic(std::size_t count, const Vec3* x, const Vec3* v, const Vec3* omega, Real e,
+                   const RigidMotion& frame);
+// Gravitational -Σ g·x_j and shape-matching (κ/3) Σ_c U_c energies of the particles. With
+// `pull`, also Σ_c w_i (g_ci - x_i) per particle (-3/κ times the shape-matching gradient); with
+// `turn`, the sum of the orientations R_c q̄_i its groups pull each particle towards (x, y, z, w).
+void chain_potential(std::size_t count, const Vec3* x, const Quat* q, const Vec3* x_rest, const Quat* q_rest, Real e,
+                     Real kappa, const Vec3& g, Real& gravitational, Real& shape_matching, Vec3* pull = nullptr,
+                     Eigen::Matrix<Real, 4, 1>* turn = nullptr, const Quat* guesses = nullptr);
+
+// The energy budget (rod_energy_budget.cpp, docs/algorithms.md §3.3): the energy a window of
+// 1/24 s may end with, relative to the root's rigid motion over it.
+struct EnergyBudget {
+  RigidMotion motion;  // the root's motion over the window (origin: the root at its end)
+  Real energy = 0;
+};
+struct BudgetScratch {
+  Vec3List x_carried, x_trial;
+  QuatList q_carried, q_trial;
+};
+// Opens a window on the state now (root at origin, rotation; `shape` its shape-matching energy;
+// gravity the solver's, asleep as EnergyWindow::asleep), `phase` base substeps into its 1/24 s
+// (0, or where the one it replaces had got to when the rest shape changed).
+void open_energy_window(std::size_t count, RodState& s, const Vec3& origin, const Quat& rotation, Real shape,
+                        const Vec3& gravity, bool asleep, int phase);
+// Closes the window `duration` seconds after it opened, the root now at origin, rotation:
+// brings the state back within the budget if it ended above it. Returns the shape-matching
+// energy of the state kept (to open the next window with); `guesses` (may be null): each group's
+// rotation from the solver's last iteration, to start its fit from; `rests` when it put the state back
+// where the window began with the root still (the next window may sleep).
+Real close_energy_window(std::size_t count, RodState& s, const Vec3* x_rest, const Quat* q_rest, const Real* lengths,
+                         Real e, Real kappa, const Vec3& g, const Vec3& origin, const Quat& rotation, Real duration,
+                         const std::vector<Collider>& colliders, Real radius, const Quat* guesses,
+                         BudgetScratch& scratch, bool& rests);
 
 // Rest particles in the anchor frame (see the header for the particle layout).
 void rest_particles(const ChainGeometry& g, const QuatList& rest, Vec3List& x_rest, QuatList& q_rest);

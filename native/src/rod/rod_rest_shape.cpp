@@ -119,12 +119,15 @@ void RodSystem::begin_frame(std::size_t r, const FrameInput& input, const std::v
     s.last_output.assign(n, Quat::Identity());
     s.time_accumulator = 0;
     s.rest_local = rest;
+    s.window.steps = -1;
+    s.window.reopen = false;
     s.initialised = true;
     return;
   }
 
   bool changed = false;
   for (std::size_t k = 0; k < n && !changed; ++k) changed = !(rest[k].coeffs() == s.rest_local[k].coeffs());
+  if (changed) s.window.reopen = true;  // its energy was measured against the old rest shape
   if (changed && rod.params.momentum_control) {
     // Momentum control (the contribution of Koyama & Igarashi 2013, our formulation):
     // keep each joint's deviation from rest, E_k = rest_old_k⁻¹ · local_k, and re-apply it

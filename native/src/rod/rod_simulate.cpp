@@ -1,6 +1,7 @@
 // One frame of one rod (docs/algorithms.md §3.3): substeps of oriented-particle shape
 // matching (Müller & Chentanez 2011, "Solid simulation with oriented particles") with
-// exact inextensibility (rod/inextensibility.hpp, Goldenthal et al. 2007).
+// exact inextensibility (rod/inextensibility.hpp, Goldenthal et al. 2007), held to an energy
+// budget every 1/24 s (rod_energy_budget.cpp).
 #include "kodawari/rod/rod_system.hpp"
 
 #include <algorithm>
@@ -32,6 +33,7 @@ struct SimulationScratch {
   std::vector<Mat3, Eigen::aligned_allocator<Mat3>> orientation_terms;
   QuatList orientation_quats;
   Vec3List displacement;
+  BudgetScratch budget;  // the energy budget's work arrays
 };
 
 SimulationScratch& simulation_scratch() {
@@ -126,6 +128,14 @@ void RodSystem::simulate(std::size_t r, const FrameInput& input, const std::vect
   const Real frame_time = steps > 0 ? Real(steps) * base_dt : Real(1);
   const Vec3 anchor_velocity = (anchor_end - anchor_start) / frame_time;
 
+  // Energy budget (docs/algorithms.md §3.3, "Energy budget"): every 1/24 s of simulated time
+  // (`substeps` base substeps, whatever the frame rate) the state may hold no more energy,
+  // relative to the root's motion, than when that window began. Wind is an input the budget
+  // does not account for: no budget while it blows.
+  const bool budgeted = p.wind.squaredNorm() == 0;
+  if (!budgeted) s.window.steps = -1;
+  const Real kappa = shape_stiffness(p);
+
   w.orientation_terms.resize(count);
   w.orientation_quats.resize(count);
   w.displacement.resize(count);
@@ -133,6 +143,36 @@ void RodSystem::simulate(std::size_t r, const FrameInput& input, const std::vect
   Vec3* x = s.x.data();
   Quat* q = s.q.data();
   for (long step = 1; step <= steps; ++step) {
+    if (budgeted && (s.window.steps < 0 || s.window.reopen)) {
+      // A new window, or (the rest shape changed: its energy is input) a fresh start of the
+      // current one that still ends where it would have, so windows close at the same simulated
+      // times whatever the frame rate and however often the view changes the rest shape.
+      Real gravitational = 0, shape = 0;
+      chain_potential(count, x, q, w.x_rest.data(), w.q_rest.data(), ellipsoid, kappa, gravity, gravitational, shape);
+      open_energy_window(count, s, x[1], q[0], shape, gravity, false, std::max(s.window.steps, 0));
+    }
+    if (budgeted && s.window.asleep) {
+      // Asleep (EnergyWindow::asleep): skip this substep while nothing that could move the chain
+      // has changed; any change wakes it, the window going on from the state it began with.
+      const Real f = Real(step) / Real(steps);
+      const Vec3 anchor = anchor_start + f * (anchor_end - anchor_start);
+      const Quat anchor_rotation = anchor_start_rotation.slerp(f, anchor_end_rotation).normalized();
+      bool still = (anchor - s.window.origin).squaredNorm() < Real(1e-24) &&
+                   std::abs(std::abs(anchor_rotation.dot(s.window.rotation)) - 1) < Real(1e-12) &&
+                   gravity == s.window.gravity;
+      for (std::size_t j = 2; j < count && still && !colliders.empty(); ++j) {
+        Vec3 probe = x[j];
+        still = !push_out_of_colliders(probe, colliders, p.radius);
+      }
+      if (still) {
+        if (++s.window.steps >= p.substeps) {  // the next window sleeps on
+          s.window.steps = 0;
+          s.window.first = 0;
+        }
+        continue;
+      }
+      s.window.asleep = false;
+    }
     // No joint may move more than kMaxTravel bone lengths relative to the root in one
     // substep: beyond that the length projection's linearisation no longer sees the motion it
     // corrects (its corrections add up along the chain: on long chains of short bones a
@@ -284,6 +324,29 @@ void RodSystem::simulate(std::size_t r, const FrameInput& input, const std::vect
       for (std::size_t j = 2; j < count; ++j) s.v[j] = (x[j] - s.prev_x[j]) * inverse_dt;
       for (std::size_t j = 1; j < count; ++j) s.omega[j] = angular_velocity(s.prev_q[j], q[j], dt);
     }
+    if (budgeted && ++s.window.steps >= p.substeps) {
+      // The window closes with the root where this substep left it (x[1], q[0]).
+      bool rests = false;
+      // Each group's rotation from the last iteration starts the energy's exact fit.
+      w.new_q[0] = q[0];
+      for (std::size_t c = 1; c < count; ++c) w.new_q[c] = w.new_q[c] * w.q_rest_conjugate[c];
+      const Real shape = close_energy_window(count, s, w.x_rest.data(), w.q_rest.data(), w.lengths.data(), ellipsoid,
+                                             kappa, gravity, x[1], q[0], Real(p.substeps - s.window.first) * base_dt,
+                                             colliders, p.radius, w.new_q.data(), w.budget, rests);
+      open_energy_window(count, s, x[1], q[0], shape, gravity, rests, 0);
+    }
+  }
+  if (budgeted && s.window.steps > s.window.first && !s.window.asleep) {
+    // The frame ends inside a window: what the user sees is held to the budget too. Closed here
+    // and opened again at the same phase, so the next window still ends on the 1/24 s grid.
+    const int phase = s.window.steps;
+    bool rests = false;
+    w.new_q[0] = q[0];
+    for (std::size_t c = 1; c < count; ++c) w.new_q[c] = w.new_q[c] * w.q_rest_conjugate[c];
+    const Real shape = close_energy_window(count, s, w.x_rest.data(), w.q_rest.data(), w.lengths.data(), ellipsoid,
+                                           kappa, gravity, x[1], q[0], Real(phase - s.window.first) * base_dt,
+                                           colliders, p.radius, w.new_q.data(), w.budget, rests);
+    open_energy_window(count, s, x[1], q[0], shape, gravity, false, phase);
   }
   s.anchor_position = anchor_end;
   s.anchor_rotation = anchor_end_rotation;

@@ -33,7 +33,9 @@ struct Reader {
 
 std::size_t RodSystem::rod_state_size(std::size_t r) const {
   const std::size_t n = rods_[r].bones.size();
-  return 1 + (n + 2) * (3 + 3 + 4 + 3) + n * 4 + 3 + 4 + 3 + 2 + weights_[r].size();
+  // The energy window: steps, origin, rotation, x and q of every particle, 11 moments and the shape energy.
+  return 1 + (n + 2) * (3 + 3 + 4 + 3) + n * 4 + 3 + 4 + 3 + 2 + weights_[r].size() + 1 + 3 + 4 + (n + 2) * 7 + 11 +
+         1 + 1 + 3 + 2;
 }
 
 std::size_t RodSystem::state_size() const {
@@ -60,6 +62,25 @@ void RodSystem::write_rod_state(std::size_t r, Real* out) const {
   w.put(s.time_accumulator);
   w.put(s.speed);
   for (Real v : weights_[r]) w.put(v);
+  const EnergyWindow& window = s.window;
+  const bool open = s.initialised && window.steps >= 0;
+  w.put(open ? Real(window.steps) : Real(-1));
+  w.put(open ? window.origin : Vec3::Zero());
+  w.put(open ? window.rotation : Quat::Identity());
+  for (std::size_t j = 0; j < n + 2; ++j) {
+    w.put(open ? window.x[j] : Vec3::Zero());
+    w.put(open ? window.q[j] : Quat::Identity());
+  }
+  w.put(open ? window.speed2 : Real(0));
+  w.put(open ? window.momentum : Vec3::Zero());
+  w.put(open ? window.angular : Vec3::Zero());
+  w.put(open ? window.spin2 : Real(0));
+  w.put(open ? window.spin : Vec3::Zero());
+  w.put(open ? window.shape : Real(0));
+  w.put(open && window.asleep ? Real(1) : Real(0));
+  w.put(open ? window.gravity : Vec3::Zero());
+  w.put(open ? Real(window.first) : Real(0));
+  w.put(open && window.reopen ? Real(1) : Real(0));
 }
 
 void RodSystem::read_rod_state(std::size_t r, const Real* in) {
@@ -88,6 +109,26 @@ void RodSystem::read_rod_state(std::size_t r, const Real* in) {
   s.time_accumulator = rd.real();
   s.speed = rd.real();
   for (Real& v : weights_[r]) v = rd.real();
+  EnergyWindow& window = s.window;
+  window.steps = static_cast<int>(rd.real());
+  window.origin = rd.vec();
+  window.rotation = rd.quat();
+  window.x.resize(n + 2);
+  window.q.resize(n + 2);
+  for (std::size_t j = 0; j < n + 2; ++j) {
+    window.x[j] = rd.vec();
+    window.q[j] = rd.quat();
+  }
+  window.speed2 = rd.real();
+  window.momentum = rd.vec();
+  window.angular = rd.vec();
+  window.spin2 = rd.real();
+  window.spin = rd.vec();
+  window.shape = rd.real();
+  window.asleep = rd.real() != 0;
+  window.gravity = rd.vec();
+  window.first = static_cast<int>(rd.real());
+  window.reopen = rd.real() != 0;
   // The rest shape is not stored: it is always the blend of the keys with these weights
   // (begin_frame), recomputed here bit for bit by the same function.
   if (s.initialised) {

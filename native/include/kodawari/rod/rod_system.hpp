@@ -6,7 +6,9 @@
 //   predict x and q from v, ω, gravity, wind (GLM-noise gusts), damping;
 //   `iterations` x { shape matching over each particle's neighbourhood {j-1, j, j+1},
 //                   PBD distance constraints, collider push-out };
-//   exact-length pass from the root, v = Δx/dt, ω from q·q_old⁻¹.
+//   exact-length pass from the root, v = Δx/dt, ω from q·q_old⁻¹;
+//   every 1/24 s the energy budget: no energy gained but what the root's motion brings, and a
+//   chain at rest sleeps (rod_energy_budget.cpp, docs/algorithms.md §3.3).
 // Particles: 0 = a kinematic "ghost" behind the root fixed in the parent's frame (it
 // gives the root bone its rest direction relative to the head), 1 = the root joint
 // (kinematic position, dynamic orientation), 2..n = the following joints, n+1 = the tip.
@@ -78,6 +80,31 @@ struct FrameInput {
   Real frame_dt = 1.0 / 24.0;   // seconds since the previous frame
 };
 
+// The energy budget's current window of 1/24 s of simulated time (docs/algorithms.md §3.3):
+// the state when it opened and the moments of its motion that the budget needs. Part of the
+// saved state, so a frame recalled from the cache steps on exactly as played.
+struct EnergyWindow {
+  int steps = -1;            // base substeps into the current 1/24 s; -1: none open
+  int first = 0;             // `steps` when it opened (later than 0 after a change of rest shape)
+  bool reopen = false;       // the rest shape changed: open again on the state now, same phase
+  Vec3 origin = Vec3::Zero();          // the root's pose when it opened
+  Quat rotation = Quat::Identity();
+  Vec3List x;                // particles when it opened
+  QuatList q;
+  Real speed2 = 0;           // Σ |v_j|² (dynamic joints)
+  Vec3 momentum = Vec3::Zero();  // Σ v_j
+  Vec3 angular = Vec3::Zero();   // Σ (x_j - origin) × v_j
+  Real spin2 = 0;            // Σ |ω_j|² (every particle but the ghost)
+  Vec3 spin = Vec3::Zero();      // Σ ω_j
+  Real shape = 0;            // the shape-matching energy
+  // The last window ended by putting the state back where it began, the root still: the chain
+  // rests where its energy allows and stepping it again would only repeat that. Asleep, the
+  // substeps are skipped while the root stays put, gravity is unchanged and no collider
+  // reaches a joint (as rigid-body engines put resting bodies to sleep).
+  bool asleep = false;
+  Vec3 gravity = Vec3::Zero();   // when the window opened (armature space, with the rod's factor)
+};
+
 struct RodState {
   Vec3List x, v, prev_x;     // particles (n + 2)
   QuatList q, prev_q;
@@ -89,6 +116,7 @@ struct RodState {
   Vec3 reference_position = Vec3::Zero();  // world, for the speed condition
   Real time_accumulator = 0.0;
   Real speed = 0.0;
+  EnergyWindow window;
   bool initialised = false;
 };
 
