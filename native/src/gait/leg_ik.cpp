@@ -55,8 +55,12 @@ class LegIk {
       const bool planted = feet_.contact[f * kLegCount + leg_] > 0;
       int g = f;
       while (g < frames && (feet_.contact[g * kLegCount + leg_] > 0) == planted) ++g;
-      if (planted) solve_stance(f, g);
-      else solve_swing(f, g);
+      if (planted) {
+        solve_stance(f, g);
+        if (swing_.count > 0 && swing_.first + swing_.count == f) meet_stance(f, g);
+      } else {
+        solve_swing(f, g);
+      }
       f = g;
     }
   }
@@ -97,7 +101,8 @@ class LegIk {
       // that cannot reach the foot, and a cold restart only to keep a planted foot from
       // sliding.
       Real dls[kMaxBones];
-      std::copy(seed ? seed : st.previous, (seed ? seed : st.previous) + n_, dls);
+      const Real* start = seed ? seed : (!planted && dls_from_warm_) ? angles : st.previous;
+      std::copy(start, start + n_, dls);
       const Real dls_error = solve_dls(chain_, goal2, 4 * in_.ccd_iterations, tolerance, dls).error;
       if (dls_error <= (planted ? kStanceTolerance : 2 * kSwingIkTolerance) || (planted && seed)) {
         std::copy(dls, dls + n_, angles);
@@ -233,6 +238,8 @@ class LegIk {
   // gives the other branch, and the pose crosses over, blended, where both hold it;
   // the better of the two wins.
   void solve_stance(int first, int last) {
+    stance_.first = first;
+    stance_.count = last - first;
     first_ = first;
     count_ = last - first;
     goals_.resize(count_);
@@ -334,6 +341,8 @@ class LegIk {
   void solve_swing(int first, int last) {
     const int frames = static_cast<int>(in_.target_speed.size());
     swing_dls_ = true;
+    prev_stance_first_ = stance_.first;
+    prev_stance_end_ = stance_.count > 0 && stance_.first + stance_.count == first ? first : 0;
     first_ = first;
     count_ = last - first;
     goals_.resize(count_);
@@ -376,7 +385,86 @@ class LegIk {
       }
       set_goals(best_scale);
     }
+    swing_.first = first_;
+    swing_.count = count_;
+    swing_.scale = best_scale;
+    swing_.start = state_;
+    swing_.track = best;
     finish_span(best);
+  }
+
+  // The rule at a planted frame (docs/algorithms.md §4.8): the largest ratio,
+  // over the joints, of the change into frame `into` to 3x the larger of its
+  // neighbouring changes + 1 deg, from the poses recorded so far (frames from `solved`
+  // on are not: their change counts as none).
+  Real snap_ratio(int into, int solved) const {
+    const int frames = static_cast<int>(in_.target_speed.size());
+    if (into < 1 || into >= std::min(frames, solved)) return 0;
+    auto pose = [&](int frame) { return out_.angles.data() + static_cast<std::ptrdiff_t>(frame) * out_.bones + offset_; };
+    auto step = [&](int frame, int b) {  // change from frame - 1 to frame
+      return frame >= 1 && frame < std::min(frames, solved) ? std::abs(pose(frame)[b] - pose(frame - 1)[b]) : Real(0);
+    };
+    Real worst = 0;
+    for (int b = 0; b < n_; ++b) {
+      worst = std::max(worst, step(into, b) / (3 * std::max(step(into - 1, b), step(into + 1, b)) + kPi / 180));
+    }
+    return worst;
+  }
+  // At the touch-down of the stance [f, g): the change into it and its first change.
+  Real touchdown_ratio(int f, int g) const { return std::max(snap_ratio(f, g), f + 1 < g ? snap_ratio(f + 1, g) : 0); }
+  // At the lift-off of the stance [a, b) (its swing solved): its last two changes.
+  Real liftoff_ratio(int a, int b) const {
+    return std::max(snap_ratio(b - 1, b + 1), b - 2 >= a ? snap_ratio(b - 2, b + 1) : 0);
+  }
+
+  // The swing before the stance [f, g) crossed over to a solve run backward from the
+  // stance's touch-down pose, each frame started from the stance's joint motion carried
+  // back in time: the swing arrives moving its joints the way the stance goes on moving
+  // them, instead of changing configuration in the touch-down frame.
+  void meet_stance(int f, int g) {
+    const Real before = touchdown_ratio(f, g);
+    if (before <= 1) return;
+    const Real lo_before = prev_stance_end_ > 0 ? liftoff_ratio(prev_stance_first_, prev_stance_end_) : 0;
+    const LegIkState after_stance = state_;
+    std::vector<Real> saved(static_cast<std::size_t>(swing_.count) * n_);
+    for (int i = 0; i < swing_.count; ++i) {
+      const Real* a = out_.angles.data() + static_cast<std::ptrdiff_t>(swing_.first + i) * out_.bones + offset_;
+      std::copy(a, a + n_, saved.begin() + i * n_);
+    }
+    std::vector<Real> saved_error(swing_.count);
+    for (int i = 0; i < swing_.count; ++i) saved_error[i] = out_.ik_error[(swing_.first + i) * 4 + leg_];
+    first_ = swing_.first;
+    count_ = swing_.count;
+    goals_.resize(count_);
+    goals2_.resize(count_);
+    set_goals(swing_.scale);
+    state_ = swing_.start;
+    const Real* td = out_.angles.data() + static_cast<std::ptrdiff_t>(f) * out_.bones + offset_;
+    const Real* td1 = g > f + 1 ? td + out_.bones : td;
+    SwingTrack back, crossed;
+    {
+      LegIkState st;
+      std::copy(td, td + n_, st.angles);
+      std::copy(td1, td1 + n_, st.previous);
+      back.angles.resize(static_cast<std::size_t>(count_) * n_);
+      back.error.resize(count_);
+      dls_from_warm_ = true;
+      swing_dls_ = true;
+      for (int i = count_ - 1; i >= 0; --i) {
+        back.error[i] = advance(st, goals2_[i], false, false, nullptr);
+        std::copy(st.angles, st.angles + n_, back.angles.begin() + i * n_);
+      }
+      dls_from_warm_ = false;
+    }
+    const bool ok = cross(swing_.track, back, crossed, false, true);
+    if (ok && crossed.worst <= std::max(kSwingTolerance, swing_.track.worst)) {
+      for (int i = 0; i < count_; ++i) record(first_ + i, goals_[i], crossed.angles.data() + i * n_, crossed.error[i]);
+      const bool lo_worse = prev_stance_end_ > 0 && liftoff_ratio(prev_stance_first_, prev_stance_end_) > lo_before + 1e-9;
+      if (touchdown_ratio(f, g) >= before || lo_worse) {  // no better: put the swing back
+        for (int i = 0; i < count_; ++i) record(first_ + i, goals_[i], saved.data() + i * n_, saved_error[i]);
+      }
+    }
+    state_ = after_stance;
   }
 
   const BakeInput& in_;
@@ -388,6 +476,15 @@ class LegIk {
   LegIkState state_;
   int first_ = 0, count_ = 0;  // the swing being solved
   bool swing_dls_ = true;      // swings solved by least change first (CCD where that fails)
+  bool dls_from_warm_ = false;  // least change from the warm start (joint motion carried on)
+  struct LastSwing {
+    int first = 0, count = 0;
+    Real scale = 1;
+    LegIkState start;
+    SwingTrack track;
+  } swing_;
+  struct { int first = 0, count = 0; } stance_;
+  int prev_stance_first_ = 0, prev_stance_end_ = 0;  // the stance before swing_
   std::vector<Vec3> goals_;
   std::vector<Vec2d> goals2_;
 };
