@@ -14,6 +14,7 @@ from gait_scene import (
     joint_angles,
     planted_snaps,
     select_pose_bones,
+    stance_end_ratio,
 )
 
 CASES = [
@@ -183,6 +184,44 @@ def test_planted_joints_never_snap(empty_scene, case, fps):
     0.01), and the 3x rule at the touch-down and lift-off frames at 24 and 60 fps (up to 11x the
     allowance at 24 fps, whose gallop stances last 1-2 frames; docs/algorithms.md
     §4.8, "Touch-down at film frame rates")."""
+    result, legs = _bake_to_a_gallop_and_back(empty_scene, case, fps)
+    heading = headings(legs)
+    for k, leg in enumerate(LEGS):
+        planted = result["contacts"][:, k] > 0.5
+        step, ratio = planted_snaps(
+            joint_angles(legs[leg], heading),
+            planted,
+            min_stance=1 if fps >= 240 else 4,
+            touchdown=True,
+        )
+        if fps >= 240:
+            assert step <= 10.0, (case, leg, step)
+        else:
+            assert ratio <= 1.0, (case, leg, ratio)  # measured 0.35
+
+
+@pytest.mark.parametrize("case,fps", [("cat@0.01", 24), ("cat@0.01", 60), ("game", 60)])
+def test_touch_down_joints_carry_on_from_the_swing(empty_scene, case, fps):
+    """At touch-down a swinging leg used to arrive in a configuration its stance left at
+    once: a joint hardly moving in the swing's last frames turned up to 30 deg into the
+    touch-down frame and stopped again (Rigify cat at 0.01, 24 fps). On this ramp that
+    was 3.7x the issue's allowance (3x the neighbouring frames' change + 1 deg) on the
+    cat at 24 fps, 6.1x on the cat at 60 fps and 5.1x on the game-style rig at 60 fps;
+    the swing now arrives carrying on the stance's joint motion: 1.80x, 1.65x, 2.26x. The issue's 3x itself (ratio <= 1)
+    is not met at the stance ends at 24 and 60 fps (docs/algorithms.md §4.8): this
+    asserts what is reached, counting every planted change, touch-down and lift-off
+    neighbours included."""
+    result, legs = _bake_to_a_gallop_and_back(empty_scene, case, fps)
+    heading = headings(legs)
+    for k, leg in enumerate(LEGS):
+        planted = result["contacts"][:, k] > 0.5
+        ratio = stance_end_ratio(joint_angles(legs[leg], heading), planted)
+        assert ratio <= 2.5, (case, fps, leg, ratio)
+
+
+def _bake_to_a_gallop_and_back(empty_scene, case, fps):
+    """0.7 x walk top -> 0.9 x gallop top -> 0.7 x walk top over 7 s at `fps`, baked:
+    (the bake's result, the evaluated legs)."""
     from kodawari.gait import runtime
 
     empty_scene.render.fps, empty_scene.render.fps_base = fps, 1.0
@@ -207,20 +246,7 @@ def test_planted_joints_never_snap(empty_scene, case, fps):
         obj.keyframe_insert(data_path="kodawari_gait.speed", frame=frame)
     assert bpy.ops.kodawari.gait_bake(frame_start=1, frame_end=end) == {"FINISHED"}
     result = runtime.last_bake(obj)["result"]
-    legs = evaluated_legs(obj, np.arange(1, end + 1))
-    heading = headings(legs)
-    for k, leg in enumerate(LEGS):
-        planted = result["contacts"][:, k] > 0.5
-        step, ratio = planted_snaps(
-            joint_angles(legs[leg], heading),
-            planted,
-            min_stance=1 if fps >= 240 else 4,
-            touchdown=True,
-        )
-        if fps >= 240:
-            assert step <= 10.0, (case, leg, step)
-        else:
-            assert ratio <= 1.0, (case, leg, ratio)  # measured 0.35
+    return result, evaluated_legs(obj, np.arange(1, end + 1))
 
 
 @pytest.mark.parametrize("animal", ["cat", "wolf", "horse"])
