@@ -25,6 +25,9 @@ constexpr Real kStanceSlide = 3e-3;
 constexpr int kRelaxPasses = 24;
 // A planted joint turning faster than this (rad/s, 1200 deg/s) is spread (LegIk::relax).
 constexpr Real kSnapRate = 1200 * kPi / 180;
+// Passes over the bake in which each swing meets its stances (LegIk::meet_stances): a
+// short stance ties one swing's end to the next one's start.
+constexpr int kMeetPasses = 2;
 // Shares of the gait's swing lift tried, in order, for a swing the leg cannot follow.
 constexpr Real kLiftScales[] = {1.0, 0.75, 0.5, 0.25, 0.0};
 
@@ -55,13 +58,18 @@ class LegIk {
       const bool planted = feet_.contact[f * kLegCount + leg_] > 0;
       int g = f;
       while (g < frames && (feet_.contact[g * kLegCount + leg_] > 0) == planted) ++g;
-      if (planted) {
-        solve_stance(f, g);
-        if (swing_.count > 0 && swing_.first + swing_.count == f) meet_stance(f, g);
-      } else {
-        solve_swing(f, g);
-      }
+      if (planted) solve_stance(f, g);
+      else solve_swing(f, g);
+      spans_.push_back({f, g, planted, planted ? Real(1) : swing_scale_});
       f = g;
+    }
+    // Every span solved: each swing meets the stances either side of it, and each stance
+    // is relaxed again between its two swings (docs/algorithms.md §4.8).
+    for (int pass = 0; pass < kMeetPasses; ++pass) {
+      for (std::size_t i = 0; i < spans_.size(); ++i) {
+        if (spans_[i].planted) smooth_stance(i);
+        else meet_stances(i);
+      }
     }
   }
 
@@ -238,8 +246,6 @@ class LegIk {
   // gives the other branch, and the pose crosses over, blended, where both hold it;
   // the better of the two wins.
   void solve_stance(int first, int last) {
-    stance_.first = first;
-    stance_.count = last - first;
     first_ = first;
     count_ = last - first;
     goals_.resize(count_);
@@ -277,7 +283,7 @@ class LegIk {
       for (int i = 0; i < count_; ++i) {
         const Real* before = i == 0 ? state_.angles : track.angles.data() + (i - 1) * n_;
         const Real* here = track.angles.data() + i * n_;
-        const Real* after = i + 1 < count_ ? here + n_ : here;
+        const Real* after = i + 1 < count_ ? here + n_ : relax_after_ ? relax_after_ : here;
         Real* pose = next.data() + i * n_;
         for (int b = 0; b < n_; ++b) pose[b] = (before[b] + 2 * here[b] + after[b]) / 4;
         const Real error = solve_dls(chain_, goals2_[i], 4 * in_.ccd_iterations, kIkTolerance, pose).error;
@@ -341,8 +347,6 @@ class LegIk {
   void solve_swing(int first, int last) {
     const int frames = static_cast<int>(in_.target_speed.size());
     swing_dls_ = true;
-    prev_stance_first_ = stance_.first;
-    prev_stance_end_ = stance_.count > 0 && stance_.first + stance_.count == first ? first : 0;
     first_ = first;
     count_ = last - first;
     goals_.resize(count_);
@@ -385,11 +389,7 @@ class LegIk {
       }
       set_goals(best_scale);
     }
-    swing_.first = first_;
-    swing_.count = count_;
-    swing_.scale = best_scale;
-    swing_.start = state_;
-    swing_.track = best;
+    swing_scale_ = best_scale;
     finish_span(best);
   }
 
@@ -411,60 +411,162 @@ class LegIk {
     return worst;
   }
   // At the touch-down of the stance [f, g): the change into it and its first change.
-  Real touchdown_ratio(int f, int g) const { return std::max(snap_ratio(f, g), f + 1 < g ? snap_ratio(f + 1, g) : 0); }
-  // At the lift-off of the stance [a, b) (its swing solved): its last two changes.
+  Real touchdown_ratio(int f, int g) const {
+    const int all = static_cast<int>(in_.target_speed.size());
+    return std::max(snap_ratio(f, all), f + 1 < g ? snap_ratio(f + 1, all) : 0);
+  }
+  // At the lift-off of the stance [a, b): its last two changes.
   Real liftoff_ratio(int a, int b) const {
-    return std::max(snap_ratio(b - 1, b + 1), b - 2 >= a ? snap_ratio(b - 2, b + 1) : 0);
+    const int all = static_cast<int>(in_.target_speed.size());
+    return std::max(snap_ratio(b - 1, all), b - 2 >= a ? snap_ratio(b - 2, all) : 0);
   }
 
-  // The swing before the stance [f, g) crossed over to a solve run backward from the
-  // stance's touch-down pose, each frame started from the stance's joint motion carried
-  // back in time: the swing arrives moving its joints the way the stance goes on moving
-  // them, instead of changing configuration in the touch-down frame.
-  void meet_stance(int f, int g) {
-    const Real before = touchdown_ratio(f, g);
+  // The swing spans_[i] and the stances either side of it (docs/algorithms.md §4.8,
+  // "The swing meets its stance"): where the previous stance's lift-off or the next
+  // one's touch-down breaks the rule, other solves of the swing are tried --
+  // forward from lift-off carrying on the stance's joint motion (least change from the
+  // warm start), backward from touch-down carrying the next stance's motion back in
+  // time, and crossings from the forward solves to the backward one (over the whole
+  // swing, or where both follow the path) -- and the one with the lowest ratio at both
+  // ends is kept, if it follows the swing's path as well and meets the stance with no
+  // larger change than before. The hoof's path stays as planned: only the leg's
+  // configuration in the air changes.
+  void meet_stances(std::size_t i) {
+    const int frames = static_cast<int>(in_.target_speed.size());
+    const Span& swing = spans_[i];
+    const Span* lifted = i > 0 && spans_[i - 1].planted ? &spans_[i - 1] : nullptr;
+    const Span* landed = i + 1 < spans_.size() && spans_[i + 1].planted ? &spans_[i + 1] : nullptr;
+    if (swing.first < 2) return;
+    auto score = [&] {
+      return std::max(lifted ? liftoff_ratio(lifted->first, lifted->last) : 0,
+                      landed ? touchdown_ratio(landed->first, landed->last) : 0);
+    };
+    const Real before = score();
     if (before <= 1) return;
-    const Real lo_before = prev_stance_end_ > 0 ? liftoff_ratio(prev_stance_first_, prev_stance_end_) : 0;
-    const LegIkState after_stance = state_;
-    std::vector<Real> saved(static_cast<std::size_t>(swing_.count) * n_);
-    for (int i = 0; i < swing_.count; ++i) {
-      const Real* a = out_.angles.data() + static_cast<std::ptrdiff_t>(swing_.first + i) * out_.bones + offset_;
-      std::copy(a, a + n_, saved.begin() + i * n_);
-    }
-    std::vector<Real> saved_error(swing_.count);
-    for (int i = 0; i < swing_.count; ++i) saved_error[i] = out_.ik_error[(swing_.first + i) * 4 + leg_];
-    first_ = swing_.first;
-    count_ = swing_.count;
+    auto pose = [&](int frame) { return out_.angles.data() + static_cast<std::ptrdiff_t>(frame) * out_.bones + offset_; };
+    first_ = swing.first;
+    count_ = swing.last - swing.first;
     goals_.resize(count_);
     goals2_.resize(count_);
-    set_goals(swing_.scale);
-    state_ = swing_.start;
-    const Real* td = out_.angles.data() + static_cast<std::ptrdiff_t>(f) * out_.bones + offset_;
-    const Real* td1 = g > f + 1 ? td + out_.bones : td;
-    SwingTrack back, crossed;
-    {
+    set_goals(swing.scale);
+    SwingTrack current;
+    current.angles.resize(static_cast<std::size_t>(count_) * n_);
+    current.error.resize(count_);
+    current.worst = 0;
+    for (int k = 0; k < count_; ++k) {
+      std::copy(pose(first_ + k), pose(first_ + k) + n_, current.angles.begin() + k * n_);
+      current.error[k] = out_.ik_error[(first_ + k) * 4 + leg_];
+      current.worst = std::max(current.worst, current.error[k]);
+    }
+    LegIkState start;  // the lift-off pose, moving as the stance moved it
+    std::copy(pose(first_ - 1), pose(first_ - 1) + n_, start.angles);
+    std::copy(pose(first_ - 2), pose(first_ - 2) + n_, start.previous);
+    swing_dls_ = true;
+    dls_from_warm_ = true;
+    std::vector<SwingTrack> tried(1);
+    state_ = start;
+    forward(tried[0]);
+    if (landed) {
+      SwingTrack back;
       LegIkState st;
-      std::copy(td, td + n_, st.angles);
-      std::copy(td1, td1 + n_, st.previous);
+      const int td = landed->first, after = std::min(td + 1, landed->last - 1);
+      std::copy(pose(td), pose(td) + n_, st.angles);
+      std::copy(pose(after), pose(after) + n_, st.previous);
       back.angles.resize(static_cast<std::size_t>(count_) * n_);
       back.error.resize(count_);
-      dls_from_warm_ = true;
-      swing_dls_ = true;
-      for (int i = count_ - 1; i >= 0; --i) {
-        back.error[i] = advance(st, goals2_[i], false, false, nullptr);
-        std::copy(st.angles, st.angles + n_, back.angles.begin() + i * n_);
+      back.worst = 0;
+      for (int k = count_ - 1; k >= 0; --k) {
+        back.error[k] = advance(st, goals2_[k], false, false, nullptr);
+        back.worst = std::max(back.worst, back.error[k]);
+        std::copy(st.angles, st.angles + n_, back.angles.begin() + k * n_);
       }
       dls_from_warm_ = false;
+      tried.resize(5);
+      state_ = start;
+      cross(current, back, tried[1], false, true);   // over the whole swing
+      cross(tried[0], back, tried[2], false, true);
+      cross(current, back, tried[3], false, false);  // where both follow the path
+      cross(tried[0], back, tried[4], false, false);
+      tried.push_back(back);
     }
-    const bool ok = cross(swing_.track, back, crossed, false, true);
-    if (ok && crossed.worst <= std::max(kSwingTolerance, swing_.track.worst)) {
-      for (int i = 0; i < count_; ++i) record(first_ + i, goals_[i], crossed.angles.data() + i * n_, crossed.error[i]);
-      const bool lo_worse = prev_stance_end_ > 0 && liftoff_ratio(prev_stance_first_, prev_stance_end_) > lo_before + 1e-9;
-      if (touchdown_ratio(f, g) >= before || lo_worse) {  // no better: put the swing back
-        for (int i = 0; i < count_; ++i) record(first_ + i, goals_[i], saved.data() + i * n_, saved_error[i]);
+    dls_from_warm_ = false;
+    // The touch-down change with `track` recorded may not be larger than the stance's
+    // own changes (or than it was): the rule is not to be met by a larger snap.
+    auto largest_step = [&](int from, int to) {  // changes into frames [from, to)
+      Real turn = 0;
+      for (int frame = std::max(1, from); frame < std::min(to, frames); ++frame) {
+        for (int b = 0; b < n_; ++b) turn = std::max(turn, std::abs(pose(frame)[b] - pose(frame - 1)[b]));
+      }
+      return turn;
+    };
+    const Real landed_pace = landed ? largest_step(landed->first + 1, landed->last) : 0;
+    const Real land_before = landed ? largest_step(landed->first, landed->first + 1) : 0;
+    auto too_fast = [&] {
+      return landed && largest_step(landed->first, landed->first + 1) > std::max(land_before, landed_pace) + 1e-9;
+    };
+    const SwingTrack* best = &current;
+    Real best_score = before;
+    for (const SwingTrack& track : tried) {
+      if (track.angles.empty() || track.worst > std::max(kSwingTolerance, current.worst)) continue;
+      for (int k = 0; k < count_; ++k) record(first_ + k, goals_[k], track.angles.data() + k * n_, track.error[k]);
+      if (too_fast()) continue;
+      const Real now = score();
+      if (now < best_score) {
+        best_score = now;
+        best = &track;
       }
     }
-    state_ = after_stance;
+    for (int k = 0; k < count_; ++k) record(first_ + k, goals_[k], best->angles.data() + k * n_, best->error[k]);
+  }
+
+  // The stance spans_[i] relaxed again with both its neighbours solved (the swing's
+  // last pose before it, the next swing's first pose after it), where one of its planted
+  // changes breaks the rule; kept if that lowers its worst ratio without a larger
+  // planted change or a foot held less well.
+  void smooth_stance(std::size_t i) {
+    const int frames = static_cast<int>(in_.target_speed.size());
+    const Span& stance = spans_[i];
+    if (stance.first < 2 || stance.last >= frames) return;
+    auto pose = [&](int frame) { return out_.angles.data() + static_cast<std::ptrdiff_t>(frame) * out_.bones + offset_; };
+    auto score = [&] {
+      Real worst = 0;
+      for (int into = stance.first; into < stance.last; ++into) worst = std::max(worst, snap_ratio(into, frames));
+      return worst;
+    };
+    auto largest_step = [&] {
+      Real turn = 0;
+      for (int frame = stance.first; frame < stance.last; ++frame) {
+        for (int b = 0; b < n_; ++b) turn = std::max(turn, std::abs(pose(frame)[b] - pose(frame - 1)[b]));
+      }
+      return turn;
+    };
+    const Real before = score();
+    if (before <= 1) return;
+    const Real turn_before = largest_step();
+    first_ = stance.first;
+    count_ = stance.last - stance.first;
+    goals_.resize(count_);
+    goals2_.resize(count_);
+    set_goals(1);
+    SwingTrack current;
+    current.angles.resize(static_cast<std::size_t>(count_) * n_);
+    current.error.resize(count_);
+    current.worst = 0;
+    for (int k = 0; k < count_; ++k) {
+      std::copy(pose(first_ + k), pose(first_ + k) + n_, current.angles.begin() + k * n_);
+      current.error[k] = out_.ik_error[(first_ + k) * 4 + leg_];
+      current.worst = std::max(current.worst, current.error[k]);
+    }
+    std::copy(pose(first_ - 1), pose(first_ - 1) + n_, state_.angles);
+    std::vector<Real> after(pose(stance.last), pose(stance.last) + n_);
+    relax_after_ = after.data();
+    SwingTrack relaxed = current;
+    relax(relaxed);
+    relax_after_ = nullptr;
+    if (relaxed.worst > std::max(current.worst, kStanceTolerance)) return;
+    for (int k = 0; k < count_; ++k) record(first_ + k, goals_[k], relaxed.angles.data() + k * n_, relaxed.error[k]);
+    if (score() < before && largest_step() <= turn_before + 1e-9) return;
+    for (int k = 0; k < count_; ++k) record(first_ + k, goals_[k], current.angles.data() + k * n_, current.error[k]);
   }
 
   const BakeInput& in_;
@@ -477,14 +579,14 @@ class LegIk {
   int first_ = 0, count_ = 0;  // the swing being solved
   bool swing_dls_ = true;      // swings solved by least change first (CCD where that fails)
   bool dls_from_warm_ = false;  // least change from the warm start (joint motion carried on)
-  struct LastSwing {
-    int first = 0, count = 0;
-    Real scale = 1;
-    LegIkState start;
-    SwingTrack track;
-  } swing_;
-  struct { int first = 0, count = 0; } stance_;
-  int prev_stance_first_ = 0, prev_stance_end_ = 0;  // the stance before swing_
+  const Real* relax_after_ = nullptr;  // the pose after a relaxed stance, if solved
+  struct Span {  // a stance or a swing, frames [first, last)
+    int first, last;
+    bool planted;
+    Real scale;  // share of the swing's lift its solve follows
+  };
+  std::vector<Span> spans_;
+  Real swing_scale_ = 1;  // of the swing solved last
   std::vector<Vec3> goals_;
   std::vector<Vec2d> goals2_;
 };
