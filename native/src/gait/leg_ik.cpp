@@ -28,6 +28,10 @@ constexpr Real kSnapRate = 1200 * kPi / 180;
 // Passes over the bake in which each swing meets its stances (LegIk::meet_stances): a
 // short stance ties one swing's end to the next one's start.
 constexpr int kMeetPasses = 2;
+// The ratio to the 3x rule (LegIk::snap_ratio) the meeting aims below: under 1 by
+// a margin, as the user's joint angles, read off the evaluated pose in the leg's plane,
+// differ a little from the solver's hinge angles.
+constexpr Real kRuleTarget = 0.9;
 // Shares of the gait's swing lift tried, in order, for a swing the leg cannot follow.
 constexpr Real kLiftScales[] = {1.0, 0.75, 0.5, 0.25, 0.0};
 
@@ -442,7 +446,7 @@ class LegIk {
                       landed ? touchdown_ratio(landed->first, landed->last) : 0);
     };
     const Real before = score();
-    if (before <= 1) return;
+    if (before <= kRuleTarget) return;
     auto pose = [&](int frame) { return out_.angles.data() + static_cast<std::ptrdiff_t>(frame) * out_.bones + offset_; };
     first_ = swing.first;
     count_ = swing.last - swing.first;
@@ -521,17 +525,21 @@ class LegIk {
 
   // The stance spans_[i] relaxed again with both its neighbours solved (the swing's
   // last pose before it, the next swing's first pose after it), where one of its planted
-  // changes breaks the rule; kept if that lowers its worst ratio without a larger
-  // planted change or a foot held less well.
+  // changes breaks the rule; kept if that lowers its worst ratio, or its ratios over 1
+  // without raising the worst, with no larger planted change and the foot held as well.
   void smooth_stance(std::size_t i) {
     const int frames = static_cast<int>(in_.target_speed.size());
     const Span& stance = spans_[i];
     if (stance.first < 2 || stance.last >= frames) return;
     auto pose = [&](int frame) { return out_.angles.data() + static_cast<std::ptrdiff_t>(frame) * out_.bones + offset_; };
-    auto score = [&] {
-      Real worst = 0;
-      for (int into = stance.first; into < stance.last; ++into) worst = std::max(worst, snap_ratio(into, frames));
-      return worst;
+    auto score = [&] {  // (the worst ratio, the sum of the ratios over 1)
+      std::pair<Real, Real> s{0, 0};
+      for (int into = stance.first; into < stance.last; ++into) {
+        const Real r = snap_ratio(into, frames);
+        s.first = std::max(s.first, r);
+        s.second += std::max(Real(0), r - kRuleTarget);
+      }
+      return s;
     };
     auto largest_step = [&] {
       Real turn = 0;
@@ -540,8 +548,8 @@ class LegIk {
       }
       return turn;
     };
-    const Real before = score();
-    if (before <= 1) return;
+    const std::pair<Real, Real> before = score();
+    if (before.first <= kRuleTarget) return;
     const Real turn_before = largest_step();
     first_ = stance.first;
     count_ = stance.last - stance.first;
@@ -565,7 +573,9 @@ class LegIk {
     relax_after_ = nullptr;
     if (relaxed.worst > std::max(current.worst, kStanceTolerance)) return;
     for (int k = 0; k < count_; ++k) record(first_ + k, goals_[k], relaxed.angles.data() + k * n_, relaxed.error[k]);
-    if (score() < before && largest_step() <= turn_before + 1e-9) return;
+    const std::pair<Real, Real> now = score();
+    const bool better = now.first < before.first || (now.first <= before.first && now.second < before.second - 1e-9);
+    if (better && largest_step() <= turn_before + 1e-9) return;
     for (int k = 0; k < count_; ++k) record(first_ + k, goals_[k], current.angles.data() + k * n_, current.error[k]);
   }
 
