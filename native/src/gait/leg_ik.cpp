@@ -23,6 +23,9 @@ constexpr Real kStanceTolerance = 1e-3;
 constexpr Real kStanceSlide = 3e-3;
 // Smoothing passes over a stance whose joint turns fast in one frame (LegIk::relax).
 constexpr int kRelaxPasses = 24;
+// A stance relaxed between its swings stops once no joint moves more than this (rad) in
+// a pass.
+constexpr Real kRelaxSettled = 1e-4;
 // A planted joint turning faster than this (rad/s, 1200 deg/s) is spread (LegIk::relax).
 constexpr Real kSnapRate = 1200 * kPi / 180;
 // Passes over the bake in which each swing meets its stances (LegIk::meet_stances): a
@@ -69,11 +72,17 @@ class LegIk {
     }
     // Every span solved: each swing meets the stances either side of it, and each stance
     // is relaxed again between its two swings (docs/algorithms.md §4.8).
+    // A later pass revisits only the spans next to one the pass before changed.
+    std::vector<char> changed(spans_.size(), 1), next(spans_.size());
     for (int pass = 0; pass < kMeetPasses; ++pass) {
+      std::fill(next.begin(), next.end(), 0);
       for (std::size_t i = 0; i < spans_.size(); ++i) {
-        if (spans_[i].planted) smooth_stance(i);
-        else meet_stances(i);
+        bool near = false;
+        for (std::size_t j = i >= 2 ? i - 2 : 0; j <= std::min(i + 2, spans_.size() - 1); ++j) near = near || changed[j];
+        if (!near) continue;
+        next[i] = spans_[i].planted ? smooth_stance(i) : meet_stances(i);
       }
+      changed.swap(next);
     }
   }
 
@@ -298,8 +307,11 @@ class LegIk {
         }
         worst = std::max(worst, track.error[i]);
       }
+      Real moved = 0;
+      for (std::size_t k = 0; k < next.size(); ++k) moved = std::max(moved, std::abs(next[k] - track.angles[k]));
       track.angles.swap(next);
       track.worst = worst;
+      if (relax_after_ && moved < kRelaxSettled) break;  // settled (the passes between swings)
     }
   }
 
@@ -435,18 +447,18 @@ class LegIk {
   // ends is kept, if it follows the swing's path as well and meets the stance with no
   // larger change than before. The hoof's path stays as planned: only the leg's
   // configuration in the air changes.
-  void meet_stances(std::size_t i) {
+  bool meet_stances(std::size_t i) {
     const int frames = static_cast<int>(in_.target_speed.size());
     const Span& swing = spans_[i];
     const Span* lifted = i > 0 && spans_[i - 1].planted ? &spans_[i - 1] : nullptr;
     const Span* landed = i + 1 < spans_.size() && spans_[i + 1].planted ? &spans_[i + 1] : nullptr;
-    if (swing.first < 2) return;
+    if (swing.first < 2) return false;
     auto score = [&] {
       return std::max(lifted ? liftoff_ratio(lifted->first, lifted->last) : 0,
                       landed ? touchdown_ratio(landed->first, landed->last) : 0);
     };
     const Real before = score();
-    if (before <= kRuleTarget) return;
+    if (before <= kRuleTarget) return false;
     auto pose = [&](int frame) { return out_.angles.data() + static_cast<std::ptrdiff_t>(frame) * out_.bones + offset_; };
     first_ = swing.first;
     count_ = swing.last - swing.first;
@@ -465,13 +477,40 @@ class LegIk {
     LegIkState start;  // the lift-off pose, moving as the stance moved it
     std::copy(pose(first_ - 1), pose(first_ - 1) + n_, start.angles);
     std::copy(pose(first_ - 2), pose(first_ - 2) + n_, start.previous);
+    // The touch-down change with a solve recorded may not be larger than the stance's
+    // own changes (or than it was): the rule is not to be met by a larger snap.
+    auto largest_step = [&](int from, int to) {  // changes into frames [from, to)
+      Real turn = 0;
+      for (int frame = std::max(1, from); frame < std::min(to, frames); ++frame) {
+        for (int b = 0; b < n_; ++b) turn = std::max(turn, std::abs(pose(frame)[b] - pose(frame - 1)[b]));
+      }
+      return turn;
+    };
+    const Real landed_pace = landed ? largest_step(landed->first + 1, landed->last) : 0;
+    const Real land_before = landed ? largest_step(landed->first, landed->first + 1) : 0;
+    SwingTrack best = current;
+    Real best_score = before;
+    auto consider = [&](const SwingTrack& track) {  // true once the rule is met
+      if (track.angles.empty() || track.worst > std::max(kSwingTolerance, current.worst)) return false;
+      for (int k = 0; k < count_; ++k) record(first_ + k, goals_[k], track.angles.data() + k * n_, track.error[k]);
+      if (landed && largest_step(landed->first, landed->first + 1) > std::max(land_before, landed_pace) + 1e-9) {
+        return false;
+      }
+      const Real now = score();
+      if (now < best_score) {
+        best_score = now;
+        best = track;
+      }
+      return best_score <= kRuleTarget;
+    };
+    // Tried in the order they most often win, until one meets the rule.
     swing_dls_ = true;
     dls_from_warm_ = true;
-    std::vector<SwingTrack> tried(1);
+    SwingTrack ahead, back, crossed;
     state_ = start;
-    forward(tried[0]);
-    if (landed) {
-      SwingTrack back;
+    forward(ahead);
+    bool met = consider(ahead);
+    if (!met && landed) {
       LegIkState st;
       const int td = landed->first, after = std::min(td + 1, landed->last - 1);
       std::copy(pose(td), pose(td) + n_, st.angles);
@@ -485,52 +524,30 @@ class LegIk {
         std::copy(st.angles, st.angles + n_, back.angles.begin() + k * n_);
       }
       dls_from_warm_ = false;
-      tried.resize(5);
-      state_ = start;
-      cross(current, back, tried[1], false, true);   // over the whole swing
-      cross(tried[0], back, tried[2], false, true);
-      cross(current, back, tried[3], false, false);  // where both follow the path
-      cross(tried[0], back, tried[4], false, false);
-      tried.push_back(back);
+      met = consider(back);
+      // Crossings to the backward solve, over the whole swing or where both follow.
+      const SwingTrack* froms[] = {&current, &ahead, &ahead, &current};
+      const bool whole[] = {true, false, true, false};
+      for (int c = 0; c < 4 && !met; ++c) {
+        state_ = start;
+        crossed = SwingTrack();
+        if (cross(*froms[c], back, crossed, false, whole[c])) met = consider(crossed);
+      }
     }
     dls_from_warm_ = false;
-    // The touch-down change with `track` recorded may not be larger than the stance's
-    // own changes (or than it was): the rule is not to be met by a larger snap.
-    auto largest_step = [&](int from, int to) {  // changes into frames [from, to)
-      Real turn = 0;
-      for (int frame = std::max(1, from); frame < std::min(to, frames); ++frame) {
-        for (int b = 0; b < n_; ++b) turn = std::max(turn, std::abs(pose(frame)[b] - pose(frame - 1)[b]));
-      }
-      return turn;
-    };
-    const Real landed_pace = landed ? largest_step(landed->first + 1, landed->last) : 0;
-    const Real land_before = landed ? largest_step(landed->first, landed->first + 1) : 0;
-    auto too_fast = [&] {
-      return landed && largest_step(landed->first, landed->first + 1) > std::max(land_before, landed_pace) + 1e-9;
-    };
-    const SwingTrack* best = &current;
-    Real best_score = before;
-    for (const SwingTrack& track : tried) {
-      if (track.angles.empty() || track.worst > std::max(kSwingTolerance, current.worst)) continue;
-      for (int k = 0; k < count_; ++k) record(first_ + k, goals_[k], track.angles.data() + k * n_, track.error[k]);
-      if (too_fast()) continue;
-      const Real now = score();
-      if (now < best_score) {
-        best_score = now;
-        best = &track;
-      }
-    }
-    for (int k = 0; k < count_; ++k) record(first_ + k, goals_[k], best->angles.data() + k * n_, best->error[k]);
+    for (int k = 0; k < count_; ++k) record(first_ + k, goals_[k], best.angles.data() + k * n_, best.error[k]);
+    return best_score < before;
   }
 
   // The stance spans_[i] relaxed again with both its neighbours solved (the swing's
   // last pose before it, the next swing's first pose after it), where one of its planted
-  // changes breaks the rule; kept if that lowers its worst ratio, or its ratios over 1
-  // without raising the worst, with no larger planted change and the foot held as well.
-  void smooth_stance(std::size_t i) {
+  // changes breaks the rule; kept if that lowers its worst ratio, or its ratios over
+  // kRuleTarget without raising the worst, with no larger planted change and the foot
+  // held as well.
+  bool smooth_stance(std::size_t i) {
     const int frames = static_cast<int>(in_.target_speed.size());
     const Span& stance = spans_[i];
-    if (stance.first < 2 || stance.last >= frames) return;
+    if (stance.first < 2 || stance.last >= frames) return false;
     auto pose = [&](int frame) { return out_.angles.data() + static_cast<std::ptrdiff_t>(frame) * out_.bones + offset_; };
     auto score = [&] {  // (the worst ratio, the sum of the ratios over 1)
       std::pair<Real, Real> s{0, 0};
@@ -549,7 +566,7 @@ class LegIk {
       return turn;
     };
     const std::pair<Real, Real> before = score();
-    if (before.first <= kRuleTarget) return;
+    if (before.first <= 1) return false;
     const Real turn_before = largest_step();
     first_ = stance.first;
     count_ = stance.last - stance.first;
@@ -571,12 +588,13 @@ class LegIk {
     SwingTrack relaxed = current;
     relax(relaxed);
     relax_after_ = nullptr;
-    if (relaxed.worst > std::max(current.worst, kStanceTolerance)) return;
+    if (relaxed.worst > std::max(current.worst, kStanceTolerance)) return false;
     for (int k = 0; k < count_; ++k) record(first_ + k, goals_[k], relaxed.angles.data() + k * n_, relaxed.error[k]);
     const std::pair<Real, Real> now = score();
     const bool better = now.first < before.first || (now.first <= before.first && now.second < before.second - 1e-9);
-    if (better && largest_step() <= turn_before + 1e-9) return;
+    if (better && largest_step() <= turn_before + 1e-9) return true;
     for (int k = 0; k < count_; ++k) record(first_ + k, goals_[k], current.angles.data() + k * n_, current.error[k]);
+    return false;
   }
 
   const BakeInput& in_;
