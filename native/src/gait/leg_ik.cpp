@@ -411,14 +411,13 @@ class LegIk {
 
   // The rule at a planted frame (docs/algorithms.md §4.8): the largest ratio,
   // over the joints, of the change into frame `into` to 3x the larger of its
-  // neighbouring changes + 1 deg, from the poses recorded so far (frames from `solved`
-  // on are not: their change counts as none).
-  Real snap_ratio(int into, int solved) const {
+  // neighbouring changes + 1 deg, from the recorded poses (every frame solved).
+  Real snap_ratio(int into) const {
     const int frames = static_cast<int>(in_.target_speed.size());
-    if (into < 1 || into >= std::min(frames, solved)) return 0;
+    if (into < 1 || into >= frames) return 0;
     auto pose = [&](int frame) { return out_.angles.data() + static_cast<std::ptrdiff_t>(frame) * out_.bones + offset_; };
     auto step = [&](int frame, int b) {  // change from frame - 1 to frame
-      return frame >= 1 && frame < std::min(frames, solved) ? std::abs(pose(frame)[b] - pose(frame - 1)[b]) : Real(0);
+      return frame >= 1 && frame < frames ? std::abs(pose(frame)[b] - pose(frame - 1)[b]) : Real(0);
     };
     Real worst = 0;
     for (int b = 0; b < n_; ++b) {
@@ -427,26 +426,21 @@ class LegIk {
     return worst;
   }
   // At the touch-down of the stance [f, g): the change into it and its first change.
-  Real touchdown_ratio(int f, int g) const {
-    const int all = static_cast<int>(in_.target_speed.size());
-    return std::max(snap_ratio(f, all), f + 1 < g ? snap_ratio(f + 1, all) : 0);
-  }
+  Real touchdown_ratio(int f, int g) const { return std::max(snap_ratio(f), f + 1 < g ? snap_ratio(f + 1) : 0); }
   // At the lift-off of the stance [a, b): its last two changes.
-  Real liftoff_ratio(int a, int b) const {
-    const int all = static_cast<int>(in_.target_speed.size());
-    return std::max(snap_ratio(b - 1, all), b - 2 >= a ? snap_ratio(b - 2, all) : 0);
-  }
+  Real liftoff_ratio(int a, int b) const { return std::max(snap_ratio(b - 1), b - 2 >= a ? snap_ratio(b - 2) : 0); }
 
   // The swing spans_[i] and the stances either side of it (docs/algorithms.md §4.8,
   // "The swing meets its stance"): where the previous stance's lift-off or the next
   // one's touch-down breaks the rule, other solves of the swing are tried --
   // forward from lift-off carrying on the stance's joint motion (least change from the
   // warm start), backward from touch-down carrying the next stance's motion back in
-  // time, and crossings from the forward solves to the backward one (over the whole
-  // swing, or where both follow the path) -- and the one with the lowest ratio at both
-  // ends is kept, if it follows the swing's path as well and meets the stance with no
-  // larger change than before. The hoof's path stays as planned: only the leg's
-  // configuration in the air changes.
+  // time, and crossings from the forward solve and the old swing to the backward one
+  // (over the whole swing, or where both follow the path) -- tried in that order until
+  // one brings both ends within kRuleTarget, else the one with the lowest ratio there
+  // is kept; a solve counts only if it follows the swing's path as well and meets the
+  // stance with no larger change than before. The hoof's path stays as planned: only
+  // the leg's configuration in the air changes.
   bool meet_stances(std::size_t i) {
     const int frames = static_cast<int>(in_.target_speed.size());
     const Span& swing = spans_[i];
@@ -552,7 +546,7 @@ class LegIk {
     auto score = [&] {  // (the worst ratio, the sum of the ratios over 1)
       std::pair<Real, Real> s{0, 0};
       for (int into = stance.first; into < stance.last; ++into) {
-        const Real r = snap_ratio(into, frames);
+        const Real r = snap_ratio(into);
         s.first = std::max(s.first, r);
         s.second += std::max(Real(0), r - kRuleTarget);
       }
