@@ -273,6 +273,22 @@ def headings(legs):
     return h / np.linalg.norm(h, axis=1, keepdims=True)
 
 
+def stance_end_ratio(angles, planted):
+    """The issue's 3x rule on every planted-leg joint change, the ends of each stance
+    included: the largest ratio of a change into a planted frame (the touch-down change,
+    from the swing's last pose, too) to 3x the larger of its neighbouring frames' changes
+    + 1 deg, whichever frames those are (the change at lift-off included)."""
+    import numpy as np
+
+    step = np.abs(np.diff(angles, axis=0))  # (F-1, n): change from frame f to f+1
+    counted = planted[1:].copy()
+    counted[[0, -1]] = False  # the timeline's first and last changes have one neighbour
+    if not counted.any():
+        return 0.0
+    neighbours = np.maximum(np.vstack([step[:1], step[:-1]]), np.vstack([step[1:], step[-1:]]))
+    return float((step / (3 * neighbours + 1.0))[counted].max())
+
+
 def planted_snaps(angles, planted, min_stance=1, touchdown=False):
     """(largest planted-joint change between frames, largest ratio of a change inside a
     stance to 3x the larger of its neighbouring frames' changes + 1 deg). The ratio

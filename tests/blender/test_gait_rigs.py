@@ -14,6 +14,7 @@ from gait_scene import (
     joint_angles,
     planted_snaps,
     select_pose_bones,
+    stance_end_ratio,
 )
 
 CASES = [
@@ -176,13 +177,60 @@ def test_planted_joints_never_snap(empty_scene, case, fps):
     """A planted leg keeps its configuration: at 240 fps no joint turns more than the
     issue's 10 deg between frames, the change into each touch-down frame included (the
     first solver: 55 deg on the sample horse; before stances were relaxed, 23 deg on one
-    hoof joint of the Rigify horse; now at most 8.9 deg on the Rigify horse, 8.8 on the
-    sample horse, 7.7 on the wolf), and at 60 fps none more than 3x its neighbouring
+    hoof joint of the Rigify horse; now at most 9.3 deg on the Rigify horse, 9.0 on the
+    sample horse, 7.8 on the wolf), and at 60 fps none more than 3x its neighbouring
     frames' change (+1 deg) inside a stance. Not yet met, so not asserted: at 240 fps
-    the fox-sized rigs (15.1 deg on the game-style rig, 13.0 on the Rigify cat at
-    0.01), and the 3x rule at the touch-down and lift-off frames at 24 and 60 fps (up to 11x the
-    allowance at 24 fps, whose gallop stances last 1-2 frames; docs/algorithms.md
-    §4.8, "Touch-down at film frame rates")."""
+    the fox-sized rigs (15.0 deg on the game-style rig, 12.7 on the Rigify cat at
+    0.01), and the 3x rule at the touch-down and lift-off frames at 24 and 60 fps (up to 2.7x
+    the allowance at 24 fps, whose gallop stances last 1-2 frames, and 1.9x at 60 fps;
+    11x and 7.9x before; docs/algorithms.md §4.8, "Touch-down at film frame rates")."""
+    result, legs = _bake_to_a_gallop_and_back(empty_scene, case, fps)
+    heading = headings(legs)
+    for k, leg in enumerate(LEGS):
+        planted = result["contacts"][:, k] > 0.5
+        step, ratio = planted_snaps(
+            joint_angles(legs[leg], heading),
+            planted,
+            min_stance=1 if fps >= 240 else 4,
+            touchdown=True,
+        )
+        if fps >= 240:
+            assert step <= 10.0, (case, leg, step)
+        else:
+            assert ratio <= 1.0, (case, leg, ratio)  # measured 0.35
+
+
+@pytest.mark.parametrize(
+    "case,fps",
+    [(c, 24) for c in ("wolf", "horse", "cat@0.01", "game", "sample_horse")]
+    + [(c, 60) for c in ("wolf", "horse", "cat@0.01", "game")],
+)
+def test_touch_down_and_lift_off_joints_carry_on_the_stance(empty_scene, case, fps):
+    """Counting every planted-leg joint change, the touch-down change and the changes
+    beside lift-off included, against the issue's allowance (3x the neighbouring frames'
+    change + 1 deg). A swinging leg used to meet its stance in another configuration
+    (a joint hardly moving in the swing's last frames turned up to 30 deg into the
+    touch-down frame and stopped again: Rigify cat at 0.01, 24 fps), to hover just
+    above the ground for the swing's last frame while the stance then swept the leg
+    back, and to stop the stance's joints dead at lift-off (wolf at 60 fps: 12.7 deg in
+    the stance's last frame, 0.4 deg at lift-off). On this ramp the worst was 7.4x
+    (wolf), 4.7x (Rigify horse), 3.7x (cat), 6.8x (game-style rig), 5.1x (sample horse)
+    at 24 fps and 5.7x, 3.7x, 6.1x, 5.0x at 60 fps. Now each swing meets its stances
+    and a cantering or galloping foot lifts off fast and strikes: 1.9x, 1.8x, 2.3x,
+    2.1x, 2.2x and 1.9x, 1.0x, 1.2x, 1.8x (the sample horse at 60 fps: 1.6x -> 1.3x).
+    The issue's 3x itself (<= 1) is not met at these stance ends (docs/algorithms.md
+    §4.8): this asserts what is reached."""
+    result, legs = _bake_to_a_gallop_and_back(empty_scene, case, fps)
+    heading = headings(legs)
+    for k, leg in enumerate(LEGS):
+        planted = result["contacts"][:, k] > 0.5
+        ratio = stance_end_ratio(joint_angles(legs[leg], heading), planted)
+        assert ratio <= 2.5, (case, fps, leg, ratio)
+
+
+def _bake_to_a_gallop_and_back(empty_scene, case, fps):
+    """0.7 x walk top -> 0.9 x gallop top -> 0.7 x walk top over 7 s at `fps`, baked:
+    (the bake's result, the evaluated legs)."""
     from kodawari.gait import runtime
 
     empty_scene.render.fps, empty_scene.render.fps_base = fps, 1.0
@@ -207,20 +255,7 @@ def test_planted_joints_never_snap(empty_scene, case, fps):
         obj.keyframe_insert(data_path="kodawari_gait.speed", frame=frame)
     assert bpy.ops.kodawari.gait_bake(frame_start=1, frame_end=end) == {"FINISHED"}
     result = runtime.last_bake(obj)["result"]
-    legs = evaluated_legs(obj, np.arange(1, end + 1))
-    heading = headings(legs)
-    for k, leg in enumerate(LEGS):
-        planted = result["contacts"][:, k] > 0.5
-        step, ratio = planted_snaps(
-            joint_angles(legs[leg], heading),
-            planted,
-            min_stance=1 if fps >= 240 else 4,
-            touchdown=True,
-        )
-        if fps >= 240:
-            assert step <= 10.0, (case, leg, step)
-        else:
-            assert ratio <= 1.0, (case, leg, ratio)  # measured 0.35
+    return result, evaluated_legs(obj, np.arange(1, end + 1))
 
 
 @pytest.mark.parametrize("animal", ["cat", "wolf", "horse"])

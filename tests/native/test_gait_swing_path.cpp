@@ -37,6 +37,22 @@ TEST(GaitSwingPath, LiftPeaksWhereTheTableSays) {
   }
 }
 
+TEST(GaitSwingPath, AStrikingFootComesDownWithSpeedASoftOneDoesNot) {
+  const Real h = 1e-6;
+  for (Real peak : {0.35, 0.4, 0.45}) {
+    for (bool strike : {false, true}) {
+      EXPECT_DOUBLE_EQ(swing_lift(0, peak, strike), 0);
+      EXPECT_NEAR(swing_lift(1, peak, strike), 0, 1e-12);
+      EXPECT_NEAR(swing_lift(peak, peak, strike), 1, 1e-9);
+      EXPECT_LT(swing_lift(peak - 0.05, peak, strike), 1);
+      EXPECT_LT(swing_lift(peak + 0.05, peak, strike), 1);
+    }
+    // Vertical speed at touch-down, in swing heights per swing time.
+    EXPECT_LT(swing_lift(1 - h, peak, false) / h, 1e-3);
+    EXPECT_GT(swing_lift(1 - h, peak, true) / h, 1.0);
+  }
+}
+
 TEST(GaitSwingPath, EaseShortensWithSpeedSoTheLagStaysSmall) {
   EXPECT_DOUBLE_EQ(swing_ease(0.5, 0.3), kEaseMax);
   EXPECT_LT(swing_ease(17, 0.33), swing_ease(5, 0.3));

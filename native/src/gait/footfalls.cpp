@@ -21,6 +21,7 @@ struct LegPlan {
   Vec3 foot = Vec3::Zero();   // planted foot, or swing start
   Vec3 target = Vec3::Zero();  // swing landing point
   Real swing_height = 0, swing_peak = 0.5, ease = kEaseMax;
+  bool strike = false;  // lands with downward speed (a gait with a flight phase)
 };
 
 // The four clocks and the rules that move them.
@@ -82,7 +83,7 @@ class FootfallPlanner {
   Real lift_at(int leg, long k) const {  // height of a swinging foot above its ground path
     const LegPlan& p = plan_[leg];
     if (p.stance) return 0;
-    return p.swing_height * swing_lift(static_cast<Real>(k - p.swing_start) / p.swing_length, p.swing_peak);
+    return p.swing_height * swing_lift(static_cast<Real>(k - p.swing_start) / p.swing_length, p.swing_peak, p.strike);
   }
 
   Vec3 foot_at(int leg, long k) const {
@@ -166,6 +167,11 @@ class FootfallPlanner {
     p.target = Vec3(land.x(), land.y(), ground_at(in_, legs_, land) + legs_.sole[leg]);
     p.swing_height = g.swing_height;
     p.swing_peak = g.swing_peak;
+    // In a gait whose stances take less than half the cycle (canter, gallop) the body
+    // flies between them: a foot leaves the ground fast and comes down at speed. A
+    // soft landing holds it just above the ground for the swing's last frame while its
+    // stance then sweeps the leg back (docs/algorithms.md §4.6, §4.8).
+    p.strike = duty(k) < 0.5;
     p.ease = swing_ease(std::max(track_.speed[track_.clamp_step(k)], v_td), g.swing_time);
   }
 

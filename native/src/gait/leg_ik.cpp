@@ -23,8 +23,18 @@ constexpr Real kStanceTolerance = 1e-3;
 constexpr Real kStanceSlide = 3e-3;
 // Smoothing passes over a stance whose joint turns fast in one frame (LegIk::relax).
 constexpr int kRelaxPasses = 24;
+// A stance relaxed between its swings stops once no joint moves more than this (rad) in
+// a pass.
+constexpr Real kRelaxSettled = 1e-4;
 // A planted joint turning faster than this (rad/s, 1200 deg/s) is spread (LegIk::relax).
 constexpr Real kSnapRate = 1200 * kPi / 180;
+// Passes over the bake in which each swing meets its stances (LegIk::meet_stances): a
+// short stance ties one swing's end to the next one's start.
+constexpr int kMeetPasses = 2;
+// The ratio to the 3x rule (LegIk::snap_ratio) the meeting aims below: under 1 by
+// a margin, as the user's joint angles, read off the evaluated pose in the leg's plane,
+// differ a little from the solver's hinge angles.
+constexpr Real kRuleTarget = 0.9;
 // Shares of the gait's swing lift tried, in order, for a swing the leg cannot follow.
 constexpr Real kLiftScales[] = {1.0, 0.75, 0.5, 0.25, 0.0};
 
@@ -57,7 +67,22 @@ class LegIk {
       while (g < frames && (feet_.contact[g * kLegCount + leg_] > 0) == planted) ++g;
       if (planted) solve_stance(f, g);
       else solve_swing(f, g);
+      spans_.push_back({f, g, planted, planted ? Real(1) : swing_scale_});
       f = g;
+    }
+    // Every span solved: each swing meets the stances either side of it, and each stance
+    // is relaxed again between its two swings (docs/algorithms.md §4.8).
+    // A later pass revisits only the spans next to one the pass before changed.
+    std::vector<char> changed(spans_.size(), 1), next(spans_.size());
+    for (int pass = 0; pass < kMeetPasses; ++pass) {
+      std::fill(next.begin(), next.end(), 0);
+      for (std::size_t i = 0; i < spans_.size(); ++i) {
+        bool near = false;
+        for (std::size_t j = i >= 2 ? i - 2 : 0; j <= std::min(i + 2, spans_.size() - 1); ++j) near = near || changed[j];
+        if (!near) continue;
+        next[i] = spans_[i].planted ? smooth_stance(i) : meet_stances(i);
+      }
+      changed.swap(next);
     }
   }
 
@@ -97,7 +122,8 @@ class LegIk {
       // that cannot reach the foot, and a cold restart only to keep a planted foot from
       // sliding.
       Real dls[kMaxBones];
-      std::copy(seed ? seed : st.previous, (seed ? seed : st.previous) + n_, dls);
+      const Real* start = seed ? seed : (!planted && dls_from_warm_) ? angles : st.previous;
+      std::copy(start, start + n_, dls);
       const Real dls_error = solve_dls(chain_, goal2, 4 * in_.ccd_iterations, tolerance, dls).error;
       if (dls_error <= (planted ? kStanceTolerance : 2 * kSwingIkTolerance) || (planted && seed)) {
         std::copy(dls, dls + n_, angles);
@@ -270,7 +296,7 @@ class LegIk {
       for (int i = 0; i < count_; ++i) {
         const Real* before = i == 0 ? state_.angles : track.angles.data() + (i - 1) * n_;
         const Real* here = track.angles.data() + i * n_;
-        const Real* after = i + 1 < count_ ? here + n_ : here;
+        const Real* after = i + 1 < count_ ? here + n_ : relax_after_ ? relax_after_ : here;
         Real* pose = next.data() + i * n_;
         for (int b = 0; b < n_; ++b) pose[b] = (before[b] + 2 * here[b] + after[b]) / 4;
         const Real error = solve_dls(chain_, goals2_[i], 4 * in_.ccd_iterations, kIkTolerance, pose).error;
@@ -281,8 +307,11 @@ class LegIk {
         }
         worst = std::max(worst, track.error[i]);
       }
+      Real moved = 0;
+      for (std::size_t k = 0; k < next.size(); ++k) moved = std::max(moved, std::abs(next[k] - track.angles[k]));
       track.angles.swap(next);
       track.worst = worst;
+      if (relax_after_ && moved < kRelaxSettled) break;  // settled (the passes between swings)
     }
   }
 
@@ -376,7 +405,190 @@ class LegIk {
       }
       set_goals(best_scale);
     }
+    swing_scale_ = best_scale;
     finish_span(best);
+  }
+
+  // The rule at a planted frame (docs/algorithms.md §4.8): the largest ratio,
+  // over the joints, of the change into frame `into` to 3x the larger of its
+  // neighbouring changes + 1 deg, from the recorded poses (every frame solved).
+  Real snap_ratio(int into) const {
+    const int frames = static_cast<int>(in_.target_speed.size());
+    if (into < 1 || into >= frames) return 0;
+    auto pose = [&](int frame) { return out_.angles.data() + static_cast<std::ptrdiff_t>(frame) * out_.bones + offset_; };
+    auto step = [&](int frame, int b) {  // change from frame - 1 to frame
+      return frame >= 1 && frame < frames ? std::abs(pose(frame)[b] - pose(frame - 1)[b]) : Real(0);
+    };
+    Real worst = 0;
+    for (int b = 0; b < n_; ++b) {
+      worst = std::max(worst, step(into, b) / (3 * std::max(step(into - 1, b), step(into + 1, b)) + kPi / 180));
+    }
+    return worst;
+  }
+  // At the touch-down of the stance [f, g): the change into it and its first change.
+  Real touchdown_ratio(int f, int g) const { return std::max(snap_ratio(f), f + 1 < g ? snap_ratio(f + 1) : 0); }
+  // At the lift-off of the stance [a, b): its last two changes.
+  Real liftoff_ratio(int a, int b) const { return std::max(snap_ratio(b - 1), b - 2 >= a ? snap_ratio(b - 2) : 0); }
+
+  // The swing spans_[i] and the stances either side of it (docs/algorithms.md §4.8,
+  // "The swing meets its stance"): where the previous stance's lift-off or the next
+  // one's touch-down breaks the rule, other solves of the swing are tried --
+  // forward from lift-off carrying on the stance's joint motion (least change from the
+  // warm start), backward from touch-down carrying the next stance's motion back in
+  // time, and crossings from the forward solve and the old swing to the backward one
+  // (over the whole swing, or where both follow the path) -- tried in that order until
+  // one brings both ends within kRuleTarget, else the one with the lowest ratio there
+  // is kept; a solve counts only if it follows the swing's path as well and meets the
+  // stance with no larger change than before. The hoof's path stays as planned: only
+  // the leg's configuration in the air changes.
+  bool meet_stances(std::size_t i) {
+    const int frames = static_cast<int>(in_.target_speed.size());
+    const Span& swing = spans_[i];
+    const Span* lifted = i > 0 && spans_[i - 1].planted ? &spans_[i - 1] : nullptr;
+    const Span* landed = i + 1 < spans_.size() && spans_[i + 1].planted ? &spans_[i + 1] : nullptr;
+    if (swing.first < 2) return false;
+    auto score = [&] {
+      return std::max(lifted ? liftoff_ratio(lifted->first, lifted->last) : 0,
+                      landed ? touchdown_ratio(landed->first, landed->last) : 0);
+    };
+    const Real before = score();
+    if (before <= kRuleTarget) return false;
+    auto pose = [&](int frame) { return out_.angles.data() + static_cast<std::ptrdiff_t>(frame) * out_.bones + offset_; };
+    first_ = swing.first;
+    count_ = swing.last - swing.first;
+    goals_.resize(count_);
+    goals2_.resize(count_);
+    set_goals(swing.scale);
+    SwingTrack current;
+    current.angles.resize(static_cast<std::size_t>(count_) * n_);
+    current.error.resize(count_);
+    current.worst = 0;
+    for (int k = 0; k < count_; ++k) {
+      std::copy(pose(first_ + k), pose(first_ + k) + n_, current.angles.begin() + k * n_);
+      current.error[k] = out_.ik_error[(first_ + k) * 4 + leg_];
+      current.worst = std::max(current.worst, current.error[k]);
+    }
+    LegIkState start;  // the lift-off pose, moving as the stance moved it
+    std::copy(pose(first_ - 1), pose(first_ - 1) + n_, start.angles);
+    std::copy(pose(first_ - 2), pose(first_ - 2) + n_, start.previous);
+    // The touch-down change with a solve recorded may not be larger than the stance's
+    // own changes (or than it was): the rule is not to be met by a larger snap.
+    auto largest_step = [&](int from, int to) {  // changes into frames [from, to)
+      Real turn = 0;
+      for (int frame = std::max(1, from); frame < std::min(to, frames); ++frame) {
+        for (int b = 0; b < n_; ++b) turn = std::max(turn, std::abs(pose(frame)[b] - pose(frame - 1)[b]));
+      }
+      return turn;
+    };
+    const Real landed_pace = landed ? largest_step(landed->first + 1, landed->last) : 0;
+    const Real land_before = landed ? largest_step(landed->first, landed->first + 1) : 0;
+    SwingTrack best = current;
+    Real best_score = before;
+    auto consider = [&](const SwingTrack& track) {  // true once the rule is met
+      if (track.angles.empty() || track.worst > std::max(kSwingTolerance, current.worst)) return false;
+      for (int k = 0; k < count_; ++k) record(first_ + k, goals_[k], track.angles.data() + k * n_, track.error[k]);
+      if (landed && largest_step(landed->first, landed->first + 1) > std::max(land_before, landed_pace) + 1e-9) {
+        return false;
+      }
+      const Real now = score();
+      if (now < best_score) {
+        best_score = now;
+        best = track;
+      }
+      return best_score <= kRuleTarget;
+    };
+    // Tried in the order they most often win, until one meets the rule.
+    swing_dls_ = true;
+    dls_from_warm_ = true;
+    SwingTrack ahead, back, crossed;
+    state_ = start;
+    forward(ahead);
+    bool met = consider(ahead);
+    if (!met && landed) {
+      LegIkState st;
+      const int td = landed->first, after = std::min(td + 1, landed->last - 1);
+      std::copy(pose(td), pose(td) + n_, st.angles);
+      std::copy(pose(after), pose(after) + n_, st.previous);
+      back.angles.resize(static_cast<std::size_t>(count_) * n_);
+      back.error.resize(count_);
+      back.worst = 0;
+      for (int k = count_ - 1; k >= 0; --k) {
+        back.error[k] = advance(st, goals2_[k], false, false, nullptr);
+        back.worst = std::max(back.worst, back.error[k]);
+        std::copy(st.angles, st.angles + n_, back.angles.begin() + k * n_);
+      }
+      dls_from_warm_ = false;
+      met = consider(back);
+      // Crossings to the backward solve, over the whole swing or where both follow.
+      const SwingTrack* froms[] = {&current, &ahead, &ahead, &current};
+      const bool whole[] = {true, false, true, false};
+      for (int c = 0; c < 4 && !met; ++c) {
+        state_ = start;
+        crossed = SwingTrack();
+        if (cross(*froms[c], back, crossed, false, whole[c])) met = consider(crossed);
+      }
+    }
+    dls_from_warm_ = false;
+    for (int k = 0; k < count_; ++k) record(first_ + k, goals_[k], best.angles.data() + k * n_, best.error[k]);
+    return best_score < before;
+  }
+
+  // The stance spans_[i] relaxed again with both its neighbours solved (the swing's
+  // last pose before it, the next swing's first pose after it), where one of its planted
+  // changes breaks the rule; kept if that lowers its worst ratio, or its ratios over
+  // kRuleTarget without raising the worst, with no larger planted change and the foot
+  // held as well.
+  bool smooth_stance(std::size_t i) {
+    const int frames = static_cast<int>(in_.target_speed.size());
+    const Span& stance = spans_[i];
+    if (stance.first < 2 || stance.last >= frames) return false;
+    auto pose = [&](int frame) { return out_.angles.data() + static_cast<std::ptrdiff_t>(frame) * out_.bones + offset_; };
+    auto score = [&] {  // (the worst ratio, the sum of the ratios over 1)
+      std::pair<Real, Real> s{0, 0};
+      for (int into = stance.first; into < stance.last; ++into) {
+        const Real r = snap_ratio(into);
+        s.first = std::max(s.first, r);
+        s.second += std::max(Real(0), r - kRuleTarget);
+      }
+      return s;
+    };
+    auto largest_step = [&] {
+      Real turn = 0;
+      for (int frame = stance.first; frame < stance.last; ++frame) {
+        for (int b = 0; b < n_; ++b) turn = std::max(turn, std::abs(pose(frame)[b] - pose(frame - 1)[b]));
+      }
+      return turn;
+    };
+    const std::pair<Real, Real> before = score();
+    if (before.first <= 1) return false;
+    const Real turn_before = largest_step();
+    first_ = stance.first;
+    count_ = stance.last - stance.first;
+    goals_.resize(count_);
+    goals2_.resize(count_);
+    set_goals(1);
+    SwingTrack current;
+    current.angles.resize(static_cast<std::size_t>(count_) * n_);
+    current.error.resize(count_);
+    current.worst = 0;
+    for (int k = 0; k < count_; ++k) {
+      std::copy(pose(first_ + k), pose(first_ + k) + n_, current.angles.begin() + k * n_);
+      current.error[k] = out_.ik_error[(first_ + k) * 4 + leg_];
+      current.worst = std::max(current.worst, current.error[k]);
+    }
+    std::copy(pose(first_ - 1), pose(first_ - 1) + n_, state_.angles);
+    std::vector<Real> after(pose(stance.last), pose(stance.last) + n_);
+    relax_after_ = after.data();
+    SwingTrack relaxed = current;
+    relax(relaxed);
+    relax_after_ = nullptr;
+    if (relaxed.worst > std::max(current.worst, kStanceTolerance)) return false;
+    for (int k = 0; k < count_; ++k) record(first_ + k, goals_[k], relaxed.angles.data() + k * n_, relaxed.error[k]);
+    const std::pair<Real, Real> now = score();
+    const bool better = now.first < before.first || (now.first <= before.first && now.second < before.second - 1e-9);
+    if (better && largest_step() <= turn_before + 1e-9) return true;
+    for (int k = 0; k < count_; ++k) record(first_ + k, goals_[k], current.angles.data() + k * n_, current.error[k]);
+    return false;
   }
 
   const BakeInput& in_;
@@ -388,6 +600,15 @@ class LegIk {
   LegIkState state_;
   int first_ = 0, count_ = 0;  // the swing being solved
   bool swing_dls_ = true;      // swings solved by least change first (CCD where that fails)
+  bool dls_from_warm_ = false;  // least change from the warm start (joint motion carried on)
+  const Real* relax_after_ = nullptr;  // the pose after a relaxed stance, if solved
+  struct Span {  // a stance or a swing, frames [first, last)
+    int first, last;
+    bool planted;
+    Real scale;  // share of the swing's lift its solve follows
+  };
+  std::vector<Span> spans_;
+  Real swing_scale_ = 1;  // of the swing solved last
   std::vector<Vec3> goals_;
   std::vector<Vec2d> goals2_;
 };

@@ -22,11 +22,15 @@ Real swing_ease(Real v, Real swing_time) {
 }
 Real ease_lag(Real v, Real swing_time) { return v * swing_ease(v, swing_time) * swing_time + 0.008; }
 
-Real swing_lift(Real s, Real peak) {
+// 16 q^2 (1 - q)^2 (soft) or 27/4 q^2 (1 - q) (strike): 1 at their top, q = 1/2 or 2/3,
+// which q = s^gamma puts at `peak`. The strike's gamma is under 1/2 for the fast gaits'
+// early peaks, so its foot also leaves the ground fast (the limb folds at once).
+Real swing_lift(Real s, Real peak, bool strike) {
   s = std::clamp(s, Real(0), Real(1));
-  const Real gamma = std::log(0.5) / std::log(std::clamp(peak, Real(0.05), Real(0.95)));
+  const Real top = strike ? Real(2) / 3 : Real(0.5);
+  const Real gamma = std::log(top) / std::log(std::clamp(peak, Real(0.05), Real(0.95)));
   const Real q = std::pow(s, gamma);
-  return 16 * q * q * (1 - q) * (1 - q);
+  return strike ? Real(27) / 4 * q * q * (1 - q) : 16 * q * q * (1 - q) * (1 - q);
 }
 
 }  // namespace kodawari::gait

@@ -22,7 +22,9 @@ Real swing_ease(Real v, Real swing_time);
 // root while it eases: the planner keeps this much inside the reach.
 Real ease_lag(Real v, Real swing_time);
 
-// Height profile in [0, 1]: 0 at both ends with zero vertical speed, 1 at `peak`.
-Real swing_lift(Real s, Real peak);
+// Height profile in [0, 1]: 0 at both ends, 1 at `peak`. A soft landing reaches the
+// ground with zero vertical speed; a striking one (`strike`) comes down at speed, and
+// lifts off fast (docs/algorithms.md §4.6).
+Real swing_lift(Real s, Real peak, bool strike = false);
 
 }  // namespace kodawari::gait
