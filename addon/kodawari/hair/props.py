@@ -143,7 +143,7 @@ class KodawariHairRod(bpy.types.PropertyGroup):
         min=1,
         max=64,
         update=_changed,
-        description="Solver passes per step: more keeps the chain's length more exactly",
+        description="Solver passes per step: more keeps the chain's length more exactly and holds its shape more stiffly (at high Stiffness, several passes hold the shape almost rigidly)",
     )
     radius: bpy.props.FloatProperty(
         name="Radius",

@@ -294,7 +294,9 @@ STRINGS = {
     "Substeps": "サブステップ",
     "Simulation steps per 1/24 s: more for fast motion (independent of the frame rate)": "1/24秒あたりのシミュレーションステップ数：速い動きには多く（フレームレートに依存しません）",
     "Iterations": "反復回数",
-    "Solver passes per step: more keeps the chain's length more exactly": "ステップあたりのソルバーの反復回数：多いほどチェーンの長さを正確に保ちます",
+    "Solver passes per step: more keeps the chain's length more exactly and holds its shape more stiffly (at high Stiffness, several passes hold the shape almost rigidly)": (
+        "ステップあたりのソルバーの反復回数：多いほどチェーンの長さを正確に保ち、形もより硬く保ちます（剛性が高いと、数回でほぼ剛体のように形を保ちます）"
+    ),
     "Thickness of the chain: how far it stays from colliders": "チェーンの太さ：コライダーからどれだけ離れるか",
     "Wind": "風",
     "Wind speed and direction in the world; gusts vary it over time": "ワールドでの風の速さと向き、突風で時間とともに変化します",
