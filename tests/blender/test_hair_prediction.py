@@ -292,8 +292,6 @@ def test_view_keys_under_a_moving_camera_aimed_by_a_constraint_are_predicted(emp
     from hair_rig import pose_curl
 
     def run(predicting):
-        from kodawari.hair import runtime
-
         bpy.ops.wm.read_homefile(use_empty=True, use_factory_startup=True)
         scene = bpy.context.scene
         obj = _rig(scene)
@@ -308,16 +306,7 @@ def test_view_keys_under_a_moving_camera_aimed_by_a_constraint_are_predicted(emp
         for frame, location in ((1, (0, -4, 1.7)), (15, (4, 0, 1.7)), (30, (0, 4, 1.7))):
             camera.location = location
             camera.keyframe_insert("location", frame=frame)
-        original = runtime.ArmatureRuntime._predict
-        if not predicting:
-            runtime.ArmatureRuntime._predict = lambda *args: False
-        first = _FirstPass(obj)
-        bpy.app.handlers.frame_change_post.append(first)  # runs after the add-on's handler
-        try:
-            seen = _play(scene, obj, FRAMES)
-        finally:
-            runtime.ArmatureRuntime._predict = original
-            bpy.app.handlers.frame_change_post.remove(first)
+        seen, first = _play_watched(scene, obj, predicting)
         return seen, obj, first
 
     predicted, obj, first = run(predicting=True)
@@ -328,6 +317,24 @@ def test_view_keys_under_a_moving_camera_aimed_by_a_constraint_are_predicted(emp
     reference, _, _ = run(predicting=False)
     assert np.abs(reference[30][0] - reference[1][0]).max() > 0.05, "the view should bend it"
     _assert_same(predicted, reference, atol=1e-5)
+
+
+def _play_watched(scene, obj, predicting):
+    """Play FRAMES with prediction on or off (off: every new frame takes the post-evaluation
+    path), watching what Blender's first evaluation of each frame showed: (seen, first)."""
+    from kodawari.hair import runtime
+
+    original = runtime.ArmatureRuntime._predict
+    if not predicting:
+        runtime.ArmatureRuntime._predict = lambda *args: False
+    first = _FirstPass(obj)
+    bpy.app.handlers.frame_change_post.append(first)  # runs after the add-on's handler
+    try:
+        seen = _play(scene, obj, FRAMES)
+    finally:
+        runtime.ArmatureRuntime._predict = original
+        bpy.app.handlers.frame_change_post.remove(first)
+    return seen, first
 
 
 def _add_ik_arm(obj, scene, chain_count, parent="Root"):
@@ -357,8 +364,6 @@ def test_an_ik_arm_elsewhere_in_the_rig_keeps_the_hair_predicted(empty_scene):
     from kodawari.hair import predict
 
     def run(predicting):
-        from kodawari.hair import runtime
-
         bpy.ops.wm.read_homefile(use_empty=True, use_factory_startup=True)
         scene = bpy.context.scene
         obj = _rig(scene)
@@ -366,16 +371,7 @@ def test_an_ik_arm_elsewhere_in_the_rig_keeps_the_hair_predicted(empty_scene):
         # A driver elsewhere in the rig (the arm's scale) moves nothing the rods read.
         driver = obj.driver_add('pose.bones["Arm.Upper"].scale', 0).driver
         driver.type, driver.expression = "SCRIPTED", "1.1"
-        original = runtime.ArmatureRuntime._predict
-        if not predicting:
-            runtime.ArmatureRuntime._predict = lambda *args: False
-        first = _FirstPass(obj)
-        bpy.app.handlers.frame_change_post.append(first)  # runs after the add-on's handler
-        try:
-            seen = _play(scene, obj, FRAMES)
-        finally:
-            runtime.ArmatureRuntime._predict = original
-            bpy.app.handlers.frame_change_post.remove(first)
+        seen, first = _play_watched(scene, obj, predicting)
         return seen, obj, first
 
     predicted, obj, first = run(predicting=True)

@@ -176,6 +176,37 @@ class LegIk {
     return st.last_error;
   }
 
+  struct Span {  // a stance or a swing, frames [first, last)
+    int first, last;
+    bool planted;
+    Real scale;  // share of the swing's lift its solve follows
+  };
+
+  // This leg's joint angles as solved for `frame`.
+  Real* solved_pose(int frame) const {
+    return out_.angles.data() + static_cast<std::ptrdiff_t>(frame) * out_.bones + offset_;
+  }
+
+  // The span's frames as they are solved now (the solve any other must beat), with the
+  // span's goals set for `scale` of its lift.
+  SwingTrack track_as_solved(const Span& span, Real scale) {
+    first_ = span.first;
+    count_ = span.last - span.first;
+    goals_.resize(count_);
+    goals2_.resize(count_);
+    set_goals(scale);
+    SwingTrack track;
+    track.angles.resize(static_cast<std::size_t>(count_) * n_);
+    track.error.resize(count_);
+    track.worst = 0;
+    for (int k = 0; k < count_; ++k) {
+      std::copy(solved_pose(first_ + k), solved_pose(first_ + k) + n_, track.angles.begin() + k * n_);
+      track.error[k] = out_.ik_error[(first_ + k) * 4 + leg_];
+      track.worst = std::max(track.worst, track.error[k]);
+    }
+    return track;
+  }
+
   // The swing's goals, frames [first_, first_ + count), with `scale` of its lift.
   void set_goals(Real scale) {
     for (int i = 0; i < count_; ++i) {
@@ -415,9 +446,8 @@ class LegIk {
   Real snap_ratio(int into) const {
     const int frames = static_cast<int>(in_.target_speed.size());
     if (into < 1 || into >= frames) return 0;
-    auto pose = [&](int frame) { return out_.angles.data() + static_cast<std::ptrdiff_t>(frame) * out_.bones + offset_; };
     auto step = [&](int frame, int b) {  // change from frame - 1 to frame
-      return frame >= 1 && frame < frames ? std::abs(pose(frame)[b] - pose(frame - 1)[b]) : Real(0);
+      return frame >= 1 && frame < frames ? std::abs(solved_pose(frame)[b] - solved_pose(frame - 1)[b]) : Real(0);
     };
     Real worst = 0;
     for (int b = 0; b < n_; ++b) {
@@ -453,30 +483,16 @@ class LegIk {
     };
     const Real before = score();
     if (before <= kRuleTarget) return false;
-    auto pose = [&](int frame) { return out_.angles.data() + static_cast<std::ptrdiff_t>(frame) * out_.bones + offset_; };
-    first_ = swing.first;
-    count_ = swing.last - swing.first;
-    goals_.resize(count_);
-    goals2_.resize(count_);
-    set_goals(swing.scale);
-    SwingTrack current;
-    current.angles.resize(static_cast<std::size_t>(count_) * n_);
-    current.error.resize(count_);
-    current.worst = 0;
-    for (int k = 0; k < count_; ++k) {
-      std::copy(pose(first_ + k), pose(first_ + k) + n_, current.angles.begin() + k * n_);
-      current.error[k] = out_.ik_error[(first_ + k) * 4 + leg_];
-      current.worst = std::max(current.worst, current.error[k]);
-    }
+    SwingTrack current = track_as_solved(swing, swing.scale);
     LegIkState start;  // the lift-off pose, moving as the stance moved it
-    std::copy(pose(first_ - 1), pose(first_ - 1) + n_, start.angles);
-    std::copy(pose(first_ - 2), pose(first_ - 2) + n_, start.previous);
+    std::copy(solved_pose(first_ - 1), solved_pose(first_ - 1) + n_, start.angles);
+    std::copy(solved_pose(first_ - 2), solved_pose(first_ - 2) + n_, start.previous);
     // The touch-down change with a solve recorded may not be larger than the stance's
     // own changes (or than it was): the rule is not to be met by a larger snap.
     auto largest_step = [&](int from, int to) {  // changes into frames [from, to)
       Real turn = 0;
       for (int frame = std::max(1, from); frame < std::min(to, frames); ++frame) {
-        for (int b = 0; b < n_; ++b) turn = std::max(turn, std::abs(pose(frame)[b] - pose(frame - 1)[b]));
+        for (int b = 0; b < n_; ++b) turn = std::max(turn, std::abs(solved_pose(frame)[b] - solved_pose(frame - 1)[b]));
       }
       return turn;
     };
@@ -507,8 +523,8 @@ class LegIk {
     if (!met && landed) {
       LegIkState st;
       const int td = landed->first, after = std::min(td + 1, landed->last - 1);
-      std::copy(pose(td), pose(td) + n_, st.angles);
-      std::copy(pose(after), pose(after) + n_, st.previous);
+      std::copy(solved_pose(td), solved_pose(td) + n_, st.angles);
+      std::copy(solved_pose(after), solved_pose(after) + n_, st.previous);
       back.angles.resize(static_cast<std::size_t>(count_) * n_);
       back.error.resize(count_);
       back.worst = 0;
@@ -542,7 +558,6 @@ class LegIk {
     const int frames = static_cast<int>(in_.target_speed.size());
     const Span& stance = spans_[i];
     if (stance.first < 2 || stance.last >= frames) return false;
-    auto pose = [&](int frame) { return out_.angles.data() + static_cast<std::ptrdiff_t>(frame) * out_.bones + offset_; };
     auto score = [&] {  // (the worst ratio, the sum of the ratios over 1)
       std::pair<Real, Real> s{0, 0};
       for (int into = stance.first; into < stance.last; ++into) {
@@ -555,29 +570,16 @@ class LegIk {
     auto largest_step = [&] {
       Real turn = 0;
       for (int frame = stance.first; frame < stance.last; ++frame) {
-        for (int b = 0; b < n_; ++b) turn = std::max(turn, std::abs(pose(frame)[b] - pose(frame - 1)[b]));
+        for (int b = 0; b < n_; ++b) turn = std::max(turn, std::abs(solved_pose(frame)[b] - solved_pose(frame - 1)[b]));
       }
       return turn;
     };
     const std::pair<Real, Real> before = score();
     if (before.first <= 1) return false;
     const Real turn_before = largest_step();
-    first_ = stance.first;
-    count_ = stance.last - stance.first;
-    goals_.resize(count_);
-    goals2_.resize(count_);
-    set_goals(1);
-    SwingTrack current;
-    current.angles.resize(static_cast<std::size_t>(count_) * n_);
-    current.error.resize(count_);
-    current.worst = 0;
-    for (int k = 0; k < count_; ++k) {
-      std::copy(pose(first_ + k), pose(first_ + k) + n_, current.angles.begin() + k * n_);
-      current.error[k] = out_.ik_error[(first_ + k) * 4 + leg_];
-      current.worst = std::max(current.worst, current.error[k]);
-    }
-    std::copy(pose(first_ - 1), pose(first_ - 1) + n_, state_.angles);
-    std::vector<Real> after(pose(stance.last), pose(stance.last) + n_);
+    SwingTrack current = track_as_solved(stance, 1);
+    std::copy(solved_pose(first_ - 1), solved_pose(first_ - 1) + n_, state_.angles);
+    std::vector<Real> after(solved_pose(stance.last), solved_pose(stance.last) + n_);
     relax_after_ = after.data();
     SwingTrack relaxed = current;
     relax(relaxed);
@@ -602,11 +604,6 @@ class LegIk {
   bool swing_dls_ = true;      // swings solved by least change first (CCD where that fails)
   bool dls_from_warm_ = false;  // least change from the warm start (joint motion carried on)
   const Real* relax_after_ = nullptr;  // the pose after a relaxed stance, if solved
-  struct Span {  // a stance or a swing, frames [first, last)
-    int first, last;
-    bool planted;
-    Real scale;  // share of the swing's lift its solve follows
-  };
   std::vector<Span> spans_;
   Real swing_scale_ = 1;  // of the swing solved last
   std::vector<Vec3> goals_;
