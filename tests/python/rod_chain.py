@@ -6,6 +6,18 @@ import kodawari_native as kn
 import numpy as np
 
 
+def no_keys():
+    """add_rod's key arguments for a rod with no view, pose or speed keys."""
+    return dict(
+        key_conditions=np.zeros(0, np.int32),
+        key_directions=np.zeros((0, 3)),
+        key_rotations=np.zeros((0, 4)),
+        key_speeds=np.zeros(0),
+        key_influences=np.zeros(0),
+        key_shapes=np.zeros((0, 4)),
+    )
+
+
 def quat_to_matrix(q):
     w, x, y, z = q / np.linalg.norm(q)
     return np.array(

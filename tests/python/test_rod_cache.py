@@ -6,6 +6,7 @@ recomputed from the nearest checkpoint before it, bit for bit."""
 
 import kodawari_native as kn
 import numpy as np
+from rod_chain import no_keys
 
 RODS, BONES = 1000, 16  # 16,000 rod bones
 # 48 MB: about a dozen frames of this system (4.0 MB each since the state also carries the
@@ -26,12 +27,7 @@ def _system():
             offsets,
             rest,
             wind=np.zeros(3),
-            key_conditions=np.zeros(0, np.int32),
-            key_directions=np.zeros((0, 3)),
-            key_rotations=np.zeros((0, 4)),
-            key_speeds=np.zeros(0),
-            key_influences=np.zeros(0),
-            key_shapes=np.zeros((0, 4)),
+            **no_keys(),
         )
     return system, bone_count
 

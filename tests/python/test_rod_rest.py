@@ -7,7 +7,7 @@ moving, gravity changing, a collider reaching a joint."""
 
 import kodawari_native as kn
 import numpy as np
-from rod_chain import Chain, pack_matrices
+from rod_chain import Chain, no_keys, pack_matrices
 
 RADIUS = 0.1  # the collider sphere
 
@@ -36,12 +36,7 @@ class ChainWithHand(Chain):
             offsets,
             np.tile([1.0, 0, 0, 0], (self.n, 1)),
             wind=np.zeros(3),
-            key_conditions=np.zeros(0, np.int32),
-            key_directions=np.zeros((0, 3)),
-            key_rotations=np.zeros((0, 4)),
-            key_speeds=np.zeros(0),
-            key_influences=np.zeros(0),
-            key_shapes=np.zeros((0, 4)),
+            **no_keys(),
         )
         hand_bone = np.array([self.n + 1], np.int32)
         self.system.set_colliders(hand_bone, *sphere[1:])
