@@ -353,18 +353,7 @@ class ArmatureRuntime:
             return False
         gravity = _gravity(scene)
         self.matrices[self.input_bones] = matrices
-        fps = scene.render.fps / scene.render.fps_base
-        if self.last_frame != previous:
-            self.system.recall_frame(previous)
-        self.system.step(
-            self.matrices,
-            armature_matrix,
-            camera_position,
-            gravity,
-            frame / fps,
-            (frame - previous) / fps,
-            self.rotations,
-        )
+        self._step(scene, previous, frame, armature_matrix, camera_position, gravity)
         self.predicted = predict.Prediction(
             frame,
             previous,
@@ -377,6 +366,22 @@ class ArmatureRuntime:
         )
         self.status = "" if camera is not None else NO_CAMERA
         return True
+
+    def _step(self, scene, previous, frame, armature_matrix, camera, gravity):
+        """Simulates from the stored frame `previous` (recalled unless it is the state held)
+        to `frame`, self.matrices holding the frame's bones; into self.rotations."""
+        if self.last_frame != previous:
+            self.system.recall_frame(previous)
+        fps = _fps(scene)
+        self.system.step(
+            self.matrices,
+            armature_matrix,
+            camera,
+            gravity,
+            frame / fps,
+            (frame - previous) / fps,
+            self.rotations,
+        )
 
     def _confirm(self, prediction, obj, scene, frame, depsgraph):
         """After the pass that follows a prediction: the frame stands when Blender's inputs are
@@ -395,17 +400,7 @@ class ArmatureRuntime:
         )
         if wrong is not None:
             self.prediction_off = wrong
-            fps = scene.render.fps / scene.render.fps_base
-            self.system.recall_frame(prediction.previous)
-            self.system.step(
-                self.matrices,
-                armature_matrix,
-                camera,
-                gravity,
-                frame / fps,
-                (frame - prediction.previous) / fps,
-                self.rotations,
-            )
+            self._step(scene, prediction.previous, frame, armature_matrix, camera, gravity)
         self.system.store_frame(frame, self.rotations)
         self._write(obj, depsgraph)
         return True
@@ -488,26 +483,15 @@ class ArmatureRuntime:
             # as playback would, each evaluated by Blender and simulated by this handler.
             _replay(scene, scene.frame_start if previous is None else previous + 1, frame)
             return
-        fps = scene.render.fps / scene.render.fps_base
         armature_matrix, camera, gravity = self._inputs(obj, scene, frame, depsgraph)
         if frame <= scene.frame_start or previous is None:
             self.predictor, self.prediction_off = None, None  # looked at afresh from the start
             self.system.clear_cache()
             self.system.reset(
-                self.matrices, armature_matrix, camera, gravity, frame / fps, self.rotations
+                self.matrices, armature_matrix, camera, gravity, frame / _fps(scene), self.rotations
             )
         else:
-            if self.last_frame != previous:
-                self.system.recall_frame(previous)
-            self.system.step(
-                self.matrices,
-                armature_matrix,
-                camera,
-                gravity,
-                frame / fps,
-                (frame - previous) / fps,
-                self.rotations,
-            )
+            self._step(scene, previous, frame, armature_matrix, camera, gravity)
         self.system.store_frame(frame, self.rotations)
         self.last_frame = frame
         self._write(obj, depsgraph)
@@ -517,6 +501,10 @@ class ArmatureRuntime:
         if slot is None or self.last_frame is None:
             return None
         return self.system.weights(slot)
+
+
+def _fps(scene):
+    return scene.render.fps / scene.render.fps_base
 
 
 def _gravity(scene):
