@@ -245,8 +245,7 @@ def _remove_helpers(mod):
             bpy.data.objects.remove(helper)
             if mesh is not None and mesh.users == 0:
                 bpy.data.meshes.remove(mesh)
-    if group.users == 0:
-        bpy.data.node_groups.remove(group)
+    bpy.data.node_groups.remove(group)
 
 
 def _write_attribute(mesh, name, kind, values):
