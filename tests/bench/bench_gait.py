@@ -28,9 +28,6 @@ import bpy
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-sys.path.insert(
-    0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "blend_samples")
-)
 import benchlib
 
 print = benchlib.say  # each line at once, also through a pipe

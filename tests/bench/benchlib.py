@@ -29,6 +29,9 @@ import bpy
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 OUT = os.path.join(ROOT, "out", "bench.json")
+SAMPLES = os.path.join(ROOT, "blend_samples")
+if SAMPLES not in sys.path:  # the sample creatures the benchmarks build (not in the add-on)
+    sys.path.insert(0, SAMPLES)
 ROUNDS = 3
 CHILD_ENV = "KODAWARI_BENCH_CHILD"
 EXIT_GRACE = 60  # seconds a child may take to exit after reporting
