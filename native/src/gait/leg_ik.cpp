@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "bake_stages.hpp"
+#include "stance_even.hpp"
 #include "kodawari/parallel.hpp"
 
 namespace kodawari::gait::stages {
@@ -35,6 +36,11 @@ constexpr int kMeetPasses = 2;
 // a margin, as the user's joint angles, read off the evaluated pose in the leg's plane,
 // differ a little from the solver's hinge angles.
 constexpr Real kRuleTarget = 0.9;
+// The share of the swings either side of a stance re-solved with it when its joints are
+// evened out (LegIk::even_out_stance).
+constexpr Real kEvenSwingShare = 0.25;
+// Gauss-Newton iterations that put a foot back on its goal in each round of the evening.
+constexpr int kEvenIterations = 32;
 // Shares of the gait's swing lift tried, in order, for a swing the leg cannot follow.
 constexpr Real kLiftScales[] = {1.0, 0.75, 0.5, 0.25, 0.0};
 
@@ -83,6 +89,11 @@ class LegIk {
         next[i] = spans_[i].planted ? smooth_stance(i) : meet_stances(i);
       }
       changed.swap(next);
+    }
+    // Last, a stance whose joint turns faster than kSnapRate is evened out with the
+    // swings either side of it (docs/algorithms.md §4.8, "The fastest joint of a stance").
+    for (std::size_t i = 0; i < spans_.size(); ++i) {
+      if (spans_[i].planted) even_out_stance(i);
     }
   }
 
@@ -547,6 +558,64 @@ class LegIk {
     dls_from_warm_ = false;
     for (int k = 0; k < count_; ++k) record(first_ + k, goals_[k], best.angles.data() + k * n_, best.error[k]);
     return best_score < before;
+  }
+
+  // The stance spans_[i] re-solved with the last kEvenSwingShare of the swing before it
+  // and the first of the swing after it for the least largest joint change between
+  // frames (stance_even.cpp), where a planted joint turns faster than kSnapRate: the swing
+  // then lands in a configuration its stance can carry on from, and the stance's fastest
+  // joint is slowed. Kept only if it breaks the 3x rule at no planted frame
+  // that kept it before (a slower peak must not come as a snap beside slow frames).
+  bool even_out_stance(std::size_t i) {
+    const int frames = static_cast<int>(in_.target_speed.size());
+    if (i == 0 || i + 1 >= spans_.size() || spans_[i - 1].planted || spans_[i + 1].planted) return false;
+    const Span &swing = spans_[i - 1], &stance = spans_[i], &next = spans_[i + 1];
+    Real planted_turn = 0;  // the stance's largest change (into its frames)
+    for (int f = std::max(1, stance.first); f < stance.last; ++f) {
+      for (int b = 0; b < n_; ++b) planted_turn = std::max(planted_turn, std::abs(solved_pose(f)[b] - solved_pose(f - 1)[b]));
+    }
+    if (planted_turn <= kSnapRate / in_.fps) return false;
+    auto share = [](const Span& s) {
+      return std::clamp(static_cast<int>(std::lround((s.last - s.first) * kEvenSwingShare)), 0, s.last - s.first - 1);
+    };
+    const int start = stance.first - share(swing), end = stance.last + share(next);
+    if (start < 1 || end >= frames) return false;
+    const int count = end - start;
+    std::vector<Real> angles(static_cast<std::size_t>(count) * n_), errors(count), allowed(count);
+    std::vector<Real> old_angles, old_errors;
+    std::vector<Vec2d> goals(count);
+    std::vector<Vec3> goals3(count);
+    std::vector<char> counted(count + 1, 0);  // the changes into planted frames
+    for (int k = 0; k < count; ++k) {
+      const int f = start + k;
+      std::copy(solved_pose(f), solved_pose(f) + n_, angles.begin() + k * n_);
+      errors[k] = out_.ik_error[f * 4 + leg_];
+      const bool planted = f >= stance.first && f < stance.last;
+      const Real scale = f < stance.first ? swing.scale : planted ? 1 : next.scale;
+      goals3[k] = feet_.planned[f * kLegCount + leg_];
+      goals3[k].z() -= (1 - scale) * feet_.lift[f * kLegCount + leg_];
+      goals[k] = local_goal(f, goals3[k]);
+      allowed[k] = planted ? kStanceTolerance : kSwingIkTolerance;
+      counted[k] = planted;
+    }
+    old_angles = angles;
+    old_errors = errors;
+    if (!even_stance(chain_, goals.data(), count, solved_pose(start - 1), solved_pose(end), counted, angles, errors,
+                     kIkTolerance, allowed, kEvenIterations)) {
+      return false;
+    }
+    auto rule = [&] {  // the worst ratio to the 3x rule at the planted frames it touches
+      Real worst = 0;
+      for (int f = std::max(1, start - 2); f <= std::min(frames - 1, end + 2); ++f) {
+        if (feet_.contact[f * kLegCount + leg_] > 0) worst = std::max(worst, snap_ratio(f));
+      }
+      return worst;
+    };
+    const Real rule_before = rule();
+    for (int k = 0; k < count; ++k) record(start + k, goals3[k], angles.data() + k * n_, errors[k]);
+    if (rule() <= std::max(rule_before, Real(1))) return true;
+    for (int k = 0; k < count; ++k) record(start + k, goals3[k], old_angles.data() + k * n_, old_errors[k]);
+    return false;
   }
 
   // The stance spans_[i] relaxed again with both its neighbours solved (the swing's
