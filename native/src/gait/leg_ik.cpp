@@ -41,6 +41,8 @@ constexpr Real kRuleTarget = 0.9;
 constexpr Real kEvenSwingShare = 0.25;
 // Gauss-Newton iterations that put a foot back on its goal in each round of the evening.
 constexpr int kEvenIterations = 32;
+// Shares of the way to an evened stance tried where all of it breaks the 3x rule.
+constexpr Real kEvenBlends[] = {0.75, 0.5, 0.25};
 // Shares of the gait's swing lift tried, in order, for a swing the leg cannot follow.
 constexpr Real kLiftScales[] = {1.0, 0.75, 0.5, 0.25, 0.0};
 
@@ -90,8 +92,9 @@ class LegIk {
       }
       changed.swap(next);
     }
-    // Last, a stance whose joint turns faster than kSnapRate is evened out with the
-    // swings either side of it (docs/algorithms.md §4.8, "The fastest joint of a stance").
+    // Last, a stance whose joint turns faster than kSnapRate, or whose ends break the 3x
+    // rule, is evened out with the swings either side of it (docs/algorithms.md §4.8,
+    // "The fastest joint of a stance").
     for (std::size_t i = 0; i < spans_.size(); ++i) {
       if (spans_[i].planted) even_out_stance(i);
     }
@@ -562,19 +565,26 @@ class LegIk {
 
   // The stance spans_[i] re-solved with the last kEvenSwingShare of the swing before it
   // and the first of the swing after it for the least largest joint change between
-  // frames (stance_even.cpp), where a planted joint turns faster than kSnapRate: the swing
-  // then lands in a configuration its stance can carry on from, and the stance's fastest
-  // joint is slowed. Kept only if it breaks the 3x rule at no planted frame
-  // that kept it before (a slower peak must not come as a snap beside slow frames).
+  // frames (stance_even.cpp), where a planted joint turns faster than kSnapRate or a
+  // change at its touch-down or lift-off breaks the 3x rule: the swing then lands
+  // in a configuration its stance carries on from, and the stance's fastest joint is
+  // slowed. Kept, or else the part of the way to it that is, only if it breaks the 3x
+  // rule at no planted frame that kept it before (a slower peak must not come as a snap
+  // beside slow frames) (docs/algorithms.md §4.8, "The fastest joint of a stance").
   bool even_out_stance(std::size_t i) {
     const int frames = static_cast<int>(in_.target_speed.size());
     if (i == 0 || i + 1 >= spans_.size() || spans_[i - 1].planted || spans_[i + 1].planted) return false;
     const Span &swing = spans_[i - 1], &stance = spans_[i], &next = spans_[i + 1];
-    Real planted_turn = 0;  // the stance's largest change (into its frames)
-    for (int f = std::max(1, stance.first); f < stance.last; ++f) {
-      for (int b = 0; b < n_; ++b) planted_turn = std::max(planted_turn, std::abs(solved_pose(f)[b] - solved_pose(f - 1)[b]));
-    }
-    if (planted_turn <= kSnapRate / in_.fps) return false;
+    auto largest_step = [&](int from, int to) {  // the largest change into frames [from, to)
+      Real turn = 0;
+      for (int f = std::max(1, from); f < to; ++f) {
+        for (int b = 0; b < n_; ++b) turn = std::max(turn, std::abs(solved_pose(f)[b] - solved_pose(f - 1)[b]));
+      }
+      return turn;
+    };
+    const Real ends = std::max(touchdown_ratio(stance.first, stance.last), liftoff_ratio(stance.first, stance.last));
+    const Real turn_before = largest_step(stance.first, stance.last);
+    if (turn_before <= kSnapRate / in_.fps && ends <= 1) return false;
     auto share = [](const Span& s) {
       return std::clamp(static_cast<int>(std::lround((s.last - s.first) * kEvenSwingShare)), 0, s.last - s.first - 1);
     };
@@ -582,7 +592,6 @@ class LegIk {
     if (start < 1 || end >= frames) return false;
     const int count = end - start;
     std::vector<Real> angles(static_cast<std::size_t>(count) * n_), errors(count), allowed(count);
-    std::vector<Real> old_angles, old_errors;
     std::vector<Vec2d> goals(count);
     std::vector<Vec3> goals3(count);
     std::vector<char> counted(count + 1, 0);  // the changes into planted frames
@@ -598,8 +607,7 @@ class LegIk {
       allowed[k] = planted ? kStanceTolerance : kSwingIkTolerance;
       counted[k] = planted;
     }
-    old_angles = angles;
-    old_errors = errors;
+    const std::vector<Real> old_angles = angles, old_errors = errors;
     if (!even_stance(chain_, goals.data(), count, solved_pose(start - 1), solved_pose(end), counted, angles, errors,
                      kIkTolerance, allowed, kEvenIterations)) {
       return false;
@@ -611,9 +619,20 @@ class LegIk {
       }
       return worst;
     };
-    const Real rule_before = rule();
+    const Real rule_before = std::max(rule(), Real(1));
     for (int k = 0; k < count; ++k) record(start + k, goals3[k], angles.data() + k * n_, errors[k]);
-    if (rule() <= std::max(rule_before, Real(1))) return true;
+    if (rule() <= rule_before) return true;
+    for (Real w : kEvenBlends) {  // part of the way, each frame put back on its goal
+      bool held = true;
+      for (int k = 0; k < count && held; ++k) {
+        Real pose[kMaxBones];
+        for (int b = 0; b < n_; ++b) pose[b] = old_angles[k * n_ + b] + w * (angles[k * n_ + b] - old_angles[k * n_ + b]);
+        const Real error = solve_dls(chain_, goals[k], kEvenIterations, kIkTolerance, pose).error;
+        held = error <= std::max(old_errors[k], allowed[k]);
+        record(start + k, goals3[k], pose, error);
+      }
+      if (held && rule() <= rule_before && largest_step(stance.first, stance.last) < turn_before) return true;
+    }
     for (int k = 0; k < count; ++k) record(start + k, goals3[k], old_angles.data() + k * n_, old_errors[k]);
     return false;
   }
