@@ -456,12 +456,15 @@ class LegIk {
 
   // The rule at a planted frame (docs/algorithms.md §4.8): the largest ratio,
   // over the joints, of the change into frame `into` to 3x the larger of its
-  // neighbouring changes + 1 deg, from the recorded poses (every frame solved).
+  // neighbouring changes + 1 deg, from the recorded poses (every frame solved). The first
+  // joint counts the body's pitch too, as the user reads it off the evaluated pose.
   Real snap_ratio(int into) const {
     const int frames = static_cast<int>(in_.target_speed.size());
     if (into < 1 || into >= frames) return 0;
-    auto step = [&](int frame, int b) {  // change from frame - 1 to frame
-      return frame >= 1 && frame < frames ? std::abs(solved_pose(frame)[b] - solved_pose(frame - 1)[b]) : Real(0);
+    auto step = [&](int frame, int b) {  // change from frame - 1 to frame, as the user reads it
+      if (frame < 1 || frame >= frames) return Real(0);
+      const Real turn = solved_pose(frame)[b] - solved_pose(frame - 1)[b];
+      return std::abs(b == 0 ? turn - (pitch(frame) - pitch(frame - 1)) : turn);
     };
     Real worst = 0;
     for (int b = 0; b < n_; ++b) {
@@ -469,6 +472,13 @@ class LegIk {
     }
     return worst;
   }
+  // The body's pitch at `frame` (rad, nose up positive): the first joint's angle as the
+  // user reads it off the evaluated pose, from straight down, turns with it.
+  Real pitch(int frame) const {
+    const Vec3 ahead = poses_.rotations[frame] * in_.rig.forward;
+    return std::atan2(ahead.z(), std::hypot(ahead.x(), ahead.y()));
+  }
+
   // At the touch-down of the stance [f, g): the change into it and its first change.
   Real touchdown_ratio(int f, int g) const { return std::max(snap_ratio(f), f + 1 < g ? snap_ratio(f + 1) : 0); }
   // At the lift-off of the stance [a, b): its last two changes.
