@@ -592,7 +592,8 @@ class LegIk {
       }
       return turn;
     };
-    const Real ends = std::max(touchdown_ratio(stance.first, stance.last), liftoff_ratio(stance.first, stance.last));
+    Real ends = 0;  // the worst ratio to the 3x rule at its frames (its touch-down included)
+    for (int f = stance.first; f < stance.last; ++f) ends = std::max(ends, snap_ratio(f));
     const Real turn_before = largest_step(stance.first, stance.last);
     if (turn_before <= kSnapRate / in_.fps && ends <= 1) return false;
     auto share = [](const Span& s) {
