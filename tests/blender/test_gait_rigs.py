@@ -100,8 +100,9 @@ def _ramp(obj, fps):
 def test_walk_gallop_walk_on_the_rig(empty_scene, case):
     """The keyed world speed (+-2%), planted feet that hold (< 5 mm), a level body in
     steady gaits (pitch within +-10 deg of rest) and no planted-leg joint snapping at
-    24 fps: no change inside a stance over 3x its neighbouring frames' (+1 deg; measured
-    up to 3.04x on the fox-sized rigs, hence the 5% allowance)."""
+    24 fps: no change inside a stance over 3x its neighbouring frames' (+1 deg). A toe
+    joint leaving its limit in one 1.07 deg step at a walk, beside 0.01 deg changes, made
+    1.04x of that on the game-style rigs; with such stances evened out, at most 0.74x."""
     from kodawari.gait import runtime
 
     fps = 24
@@ -167,23 +168,34 @@ def test_walk_gallop_walk_on_the_rig(empty_scene, case):
                 anchor = None
         assert slide < 0.005, (case, leg, slide)
         _, ratio = planted_snaps(joint_angles(legs[leg], heading), planted, min_stance=4)
-        assert ratio <= 1.05, (case, leg, ratio)
+        assert ratio <= 1.0, (case, leg, ratio)
+
+
+# The largest planted-joint change between frames at 240 fps reached per rig (deg; the
+# issue's 10 on the large rigs, not yet on the fox-sized ones).
+LARGEST_STEP_240 = {
+    "horse": 8.5,
+    "sample_horse": 8.5,
+    "wolf": 8.5,
+    "game": 13.0,
+    "game@0.01/object": 14.0,
+}
 
 
 @pytest.mark.parametrize(
-    "case,fps", [("horse", 240), ("sample_horse", 240), ("wolf", 240), ("mixamo@0.01", 60)]
+    "case,fps", [(c, 240) for c in LARGEST_STEP_240] + [("mixamo@0.01", 60)]
 )
 def test_planted_joints_never_snap(empty_scene, case, fps):
     """A planted leg keeps its configuration: at 240 fps no joint turns more than the
-    issue's 10 deg between frames, the change into each touch-down frame included (the
-    first solver: 55 deg on the sample horse; before stances were relaxed, 23 deg on one
-    hoof joint of the Rigify horse; now at most 9.3 deg on the Rigify horse, 9.0 on the
-    sample horse, 7.8 on the wolf), and at 60 fps none more than 3x its neighbouring
-    frames' change (+1 deg) inside a stance. Not yet met, so not asserted: at 240 fps
-    the fox-sized rigs (15.0 deg on the game-style rig, 12.7 on the Rigify cat at
-    0.01), and the 3x rule at the touch-down and lift-off frames at 24 and 60 fps (up to 2.7x
-    the allowance at 24 fps, whose gallop stances last 1-2 frames, and 1.9x at 60 fps;
-    11x and 7.9x before; docs/algorithms.md §4.8, "Touch-down at film frame rates")."""
+    issue's 10 deg between frames, the change into each touch-down frame included, and
+    at 60 fps none more than 3x its neighbouring frames' change (+1 deg) inside a stance
+    (measured 0.35x). The first solver turned a joint 55 deg in a frame on the sample
+    horse; before stances were evened out the worst was 9.3 deg (Rigify horse), 9.0
+    (sample horse), 7.8 (wolf), 15.0 (game-style rig) and 15.7 (game-style rig at 0.01,
+    root motion on the object); now 7.8, 6.0, 7.0, 12.6 and 13.5 (docs/algorithms.md
+    §4.8, "The fastest joint of a stance"). The fox-sized rigs stay over the issue's 10:
+    their fore legs touch down and lift off nearly straight at Froude-scaled gallop
+    speeds (the Rigify cat at 0.01: 12.6, 12.8 before, so not listed here)."""
     result, legs = _bake_to_a_gallop_and_back(empty_scene, case, fps)
     heading = headings(legs)
     for k, leg in enumerate(LEGS):
@@ -195,15 +207,20 @@ def test_planted_joints_never_snap(empty_scene, case, fps):
             touchdown=True,
         )
         if fps >= 240:
-            assert step <= 10.0, (case, leg, step)
+            assert step <= LARGEST_STEP_240[case], (case, leg, step)
         else:
-            assert ratio <= 1.0, (case, leg, ratio)  # measured 0.35
+            assert ratio <= 1.0, (case, leg, ratio)
+
+
+# The issue's 3x rule at the stance ends, as far as it is reached (ratio to the allowance;
+# <= 1 is the rule met).
+STANCE_END_RATIO = {("wolf", 24): 1.3, ("cat@0.01", 24): 1.6, ("game@0.01/object", 60): 1.25}
 
 
 @pytest.mark.parametrize(
     "case,fps",
-    [(c, 24) for c in ("wolf", "horse", "cat@0.01", "game", "sample_horse")]
-    + [(c, 60) for c in ("wolf", "horse", "cat@0.01", "game")],
+    [(c, 24) for c in ("wolf", "horse", "cat@0.01", "game", "sample_horse", "game@0.01/object")]
+    + [(c, 60) for c in ("wolf", "horse", "cat@0.01", "game", "game@0.01/object")],
 )
 def test_touch_down_and_lift_off_joints_carry_on_the_stance(empty_scene, case, fps):
     """Counting every planted-leg joint change, the touch-down change and the changes
@@ -213,27 +230,29 @@ def test_touch_down_and_lift_off_joints_carry_on_the_stance(empty_scene, case, f
     touch-down frame and stopped again: Rigify cat at 0.01, 24 fps), to hover just
     above the ground for the swing's last frame while the stance then swept the leg
     back, and to stop the stance's joints dead at lift-off (wolf at 60 fps: 12.7 deg in
-    the stance's last frame, 0.4 deg at lift-off). On this ramp the worst was 7.4x
-    (wolf), 4.7x (Rigify horse), 3.7x (cat), 6.8x (game-style rig), 5.1x (sample horse)
-    at 24 fps and 5.7x, 3.7x, 6.1x, 5.0x at 60 fps. Now each swing meets its stances
-    and a cantering or galloping foot lifts off fast and strikes: 1.9x, 1.8x, 2.3x,
-    2.1x, 2.2x and 1.9x, 1.0x, 1.2x, 1.8x (the sample horse at 60 fps: 1.6x -> 1.3x).
-    The issue's 3x itself (<= 1) is not met at these stance ends (docs/algorithms.md
-    §4.8): this asserts what is reached."""
+    the stance's last frame, 0.4 deg at lift-off). The worst was 7.4x (wolf), 4.7x
+    (Rigify horse), 3.7x (cat), 6.8x (game-style rig), 5.1x (sample horse) at 24 fps;
+    with each swing meeting its stances and striking feet 1.9x, 1.8x, 2.3x, 2.1x, 2.2x
+    (1.9x on the game-style rig at 0.01 with root motion on the object) and at 60 fps
+    1.9x, 1.0x, 1.2x, 1.8x (1.9x). Now each stance breaking the rule is evened out with
+    the swings beside it: 1.24x, 0.97x, 1.55x, 1.02x, 0.97x (1.04x) at 24 fps, 1.00x,
+    0.99x, 1.00x, 0.98x (1.20x) at 60 fps (docs/algorithms.md §4.8)."""
     result, legs = _bake_to_a_gallop_and_back(empty_scene, case, fps)
     heading = headings(legs)
     for k, leg in enumerate(LEGS):
         planted = result["contacts"][:, k] > 0.5
         ratio = stance_end_ratio(joint_angles(legs[leg], heading), planted)
-        assert ratio <= 2.5, (case, fps, leg, ratio)
+        assert ratio <= STANCE_END_RATIO.get((case, fps), 1.05), (case, fps, leg, ratio)
 
 
 def _bake_to_a_gallop_and_back(empty_scene, case, fps):
     """0.7 x walk top -> 0.9 x gallop top -> 0.7 x walk top over 7 s at `fps`, baked:
-    (the bake's result, the evaluated legs)."""
+    (the bake's result, the evaluated legs). "case/object": root motion on the armature
+    object, which stands somewhere, turned."""
     from kodawari.gait import runtime
 
     empty_scene.render.fps, empty_scene.render.fps_base = fps, 1.0
+    case, _, where = case.partition("/")
     if case == "sample_horse":
         from gait_scene import horse
 
@@ -241,7 +260,10 @@ def _bake_to_a_gallop_and_back(empty_scene, case, fps):
         for child in list(obj.children):  # the skin mesh: not what is measured, slow to evaluate
             bpy.data.objects.remove(child)
     else:
-        obj = _setup(empty_scene, case)
+        obj = _setup(empty_scene, case, root_motion=where.upper() or "AUTO")
+    if where == "object":
+        obj.location = (2.0, 1.0, 0.5)
+        obj.rotation_euler = (0.0, 0.0, 0.6)
     s = obj.kodawari_gait
     top = {e.name: e.speed_max for e in s.table}
     end = 7 * fps
