@@ -182,9 +182,7 @@ LARGEST_STEP_240 = {
 }
 
 
-@pytest.mark.parametrize(
-    "case,fps", [(c, 240) for c in LARGEST_STEP_240] + [("mixamo@0.01", 60)]
-)
+@pytest.mark.parametrize("case,fps", [(c, 240) for c in LARGEST_STEP_240] + [("mixamo@0.01", 60)])
 def test_planted_joints_never_snap(empty_scene, case, fps):
     """A planted leg keeps its configuration: at 240 fps no joint turns more than the
     issue's 10 deg between frames, the change into each touch-down frame included, and
