@@ -98,6 +98,11 @@ class LegIk {
     for (std::size_t i = 0; i < spans_.size(); ++i) {
       if (spans_[i].planted) even_out_stance(i);
     }
+    // Then a lift-off still breaking the rule beside a slow first swing change carries the
+    // joint at fault on into the swing ("The lift-off carries on").
+    for (std::size_t i = 0; i < spans_.size(); ++i) {
+      if (spans_[i].planted) lift_off_carries_on(i);
+    }
   }
 
  private:
@@ -645,6 +650,60 @@ class LegIk {
       if (held && rule() <= rule_before && largest_step(stance.first, stance.last) < turn_before) return true;
     }
     for (int k = 0; k < count; ++k) record(start + k, goals3[k], old_angles.data() + k * n_, old_errors[k]);
+    return false;
+  }
+
+  // The lift-off of the stance spans_[i] where its last planted change breaks the 3x rule
+  // beside a slow lift-off change (a short stance's one sweep between a touch-down and a
+  // lift-off where the joint turns round): the swing's first frame re-solved on its path
+  // (least change, the other joints free) with each joint at fault turned on, in the
+  // direction it was turning at lift-off, by what makes its last planted change
+  // kRuleTarget of the rule's allowance. Kept if the worst ratio at the planted frames
+  // around falls and the hoof stays on its path (docs/algorithms.md §4.8).
+  bool lift_off_carries_on(std::size_t i) {
+    const int frames = static_cast<int>(in_.target_speed.size());
+    if (i + 1 >= spans_.size() || spans_[i + 1].planted) return false;
+    const Span &stance = spans_[i], &swing = spans_[i + 1];
+    const int last = stance.last - 1, lift = stance.last;
+    if (last < 2 || swing.last - swing.first < 2 || lift + 1 >= frames) return false;
+    const Real before = snap_ratio(last);
+    if (before <= 1) return false;
+    auto user = [&](int frame, int b) { return solved_pose(frame)[b] - (b == 0 ? pitch(frame) : 0); };
+    LegChain held = chain_;
+    bool any = false;
+    Real pose[kMaxBones];
+    std::copy(solved_pose(lift), solved_pose(lift) + n_, pose);
+    for (int b = 0; b < n_; ++b) {
+      const Real into = std::abs(user(last, b) - user(last - 1, b));
+      const Real out = user(lift, b) - user(last, b);
+      const Real needed = (into / kRuleTarget - kPi / 180) / 3;
+      if (into <= 3 * std::max(std::abs(user(last - 1, b) - user(last - 2, b)), std::abs(out)) + kPi / 180) continue;
+      if (std::abs(out) >= needed) continue;
+      const Real onward = user(lift + 1, b) - user(lift, b);
+      const Real sign = out != 0 ? (out > 0 ? 1 : -1) : (onward >= 0 ? 1 : -1);
+      const Real target = std::clamp(solved_pose(last)[b] + (b == 0 ? pitch(lift) - pitch(last) : 0) + sign * needed,
+                                     chain_.limit_min[b], chain_.limit_max[b]);
+      held.limit_min[b] = held.limit_max[b] = pose[b] = target;
+      any = true;
+    }
+    if (!any) return false;
+    Vec3 goal = feet_.planned[lift * kLegCount + leg_];
+    goal.z() -= (1 - swing.scale) * feet_.lift[lift * kLegCount + leg_];
+    const Real error = solve_dls(held, local_goal(lift, goal), 4 * in_.ccd_iterations, kIkTolerance, pose).error;
+    const Real old_error = out_.ik_error[lift * 4 + leg_];
+    if (error > std::max(old_error, kSwingIkTolerance)) return false;
+    auto rule = [&] {
+      Real worst = 0;
+      for (int f = std::max(1, stance.first); f <= std::min(frames - 1, lift + 3); ++f) {
+        if (feet_.contact[f * kLegCount + leg_] > 0) worst = std::max(worst, snap_ratio(f));
+      }
+      return worst;
+    };
+    const Real worst_before = rule();
+    std::vector<Real> old_pose(solved_pose(lift), solved_pose(lift) + n_);
+    record(lift, goal, pose, error);
+    if (rule() < worst_before) return true;
+    record(lift, goal, old_pose.data(), old_error);
     return false;
   }
 
