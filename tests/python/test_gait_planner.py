@@ -154,13 +154,13 @@ def test_swinging_hooves_follow_their_path_at_any_frame_rate(fps):
     assert swings > 200 and lowered <= 0.03 * swings, (lowered, swings)
 
 
-def test_planted_joints_on_the_ramp_at_240_fps_turn_no_more_than_15_deg_a_frame():
+def test_planted_joints_on_the_ramp_at_240_fps_turn_no_more_than_10_deg_a_frame():
     # The issue's own ramp (1.5 -> 17 -> 1.5 m/s) at 240 fps, on the solver's joint
     # angles, the change into each touch-down frame included: the first solver turned a
     # planted joint 79 deg in one frame; before the swings met their stances a hind hoof
     # joint still turned 34.8 deg into its touch-down frame at 15.7 m/s (the swing
-    # arriving in another configuration); now 11.6 deg. (The issue's 10 deg is met on
-    # the Blender test rigs' ramp to 0.9 of the gallop top, not on this one.)
+    # arriving in another configuration); then 11.6 deg; with each galloping stance
+    # evened out (docs/algorithms.md §4.8) 6.1 deg: the issue's 10 deg.
     fps = 240
     out, rig = bake(speed_ramp(fps), -1, fps)
     angles = np.degrees(out["angles"])
@@ -168,7 +168,7 @@ def test_planted_joints_on_the_ramp_at_240_fps_turn_no_more_than_15_deg_a_frame(
     for leg in range(4):
         a = angles[:, 4 * leg : 4 * leg + 4]
         step = np.abs(np.diff(a, axis=0))[planted[1:, leg]]
-        assert step.max() <= 15.0, (metrics.LEGS[leg], step.max())
+        assert step.max() <= 10.0, (metrics.LEGS[leg], step.max())
 
 
 def test_a_swing_across_a_gait_change_is_measured_whole():
