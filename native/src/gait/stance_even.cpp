@@ -177,7 +177,8 @@ bool even_stance(const LegChain& chain, const Vec2d* goals, int count, const Rea
     }
     if (!improved) {
       theta = from;
-      continue;  // a larger exponent may still move
+      if (p >= kLastExponent) break;  // settled at the last exponent
+      continue;                       // a larger exponent may still move
     }
     const Real turn = largest(theta, true);
     if (turn < best_turn && largest(theta, false) <= other_top) {
