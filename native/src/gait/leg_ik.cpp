@@ -43,6 +43,8 @@ constexpr Real kEvenSwingShare = 0.25;
 constexpr int kEvenIterations = 32;
 // Shares of the way to an evened stance tried where all of it breaks the 3x rule.
 constexpr Real kEvenBlends[] = {0.75, 0.5, 0.25};
+// The norm's last exponent of the evening tried after those (16 first: the largest change).
+constexpr Real kEvenRetryExponent = 8;
 // Shares of the gait's swing lift tried, in order, for a swing the leg cannot follow.
 constexpr Real kLiftScales[] = {1.0, 0.75, 0.5, 0.25, 0.0};
 
@@ -583,9 +585,10 @@ class LegIk {
   // frames (stance_even.cpp), where a planted joint turns faster than kSnapRate or a
   // change at its touch-down or lift-off breaks the 3x rule: the swing then lands
   // in a configuration its stance carries on from, and the stance's fastest joint is
-  // slowed. Kept, or else the part of the way to it that is, only if it breaks the 3x
-  // rule at no planted frame that kept it before (a slower peak must not come as a snap
-  // beside slow frames) (docs/algorithms.md §4.8, "The fastest joint of a stance").
+  // slowed. Kept, or else the part of the way to it that is, or else the same evened out
+  // less sharply (kEvenRetryExponent), only if it breaks the 3x rule at no planted frame
+  // that kept it before (a slower peak must not come as a snap beside slow frames)
+  // (docs/algorithms.md §4.8, "The fastest joint of a stance").
   bool even_out_stance(std::size_t i) {
     const int frames = static_cast<int>(in_.target_speed.size());
     if (i == 0 || i + 1 >= spans_.size() || spans_[i - 1].planted || spans_[i + 1].planted) return false;
@@ -648,6 +651,15 @@ class LegIk {
         record(start + k, goals3[k], pose, error);
       }
       if (held && rule() <= rule_before && largest_step(stance.first, stance.last) < turn_before) return true;
+    }
+    // Or evened out less sharply: a lower norm's exponent spreads the turn over more joints
+    // and frames without driving every change to the same peak.
+    angles = old_angles;
+    errors = old_errors;
+    if (even_stance(chain_, goals.data(), count, solved_pose(start - 1), solved_pose(end), counted, angles, errors,
+                    kIkTolerance, allowed, kEvenIterations, kEvenRetryExponent)) {
+      for (int k = 0; k < count; ++k) record(start + k, goals3[k], angles.data() + k * n_, errors[k]);
+      if (rule() <= rule_before) return true;
     }
     for (int k = 0; k < count; ++k) record(start + k, goals3[k], old_angles.data() + k * n_, old_errors[k]);
     return false;

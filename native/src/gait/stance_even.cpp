@@ -18,7 +18,6 @@ using VecX = Eigen::Matrix<Real, Eigen::Dynamic, 1>;
 constexpr int kRounds = 40;
 // The norm's exponent rises over the rounds from a plain least squares smoothing (p = 2,
 // a geodesic-like path) towards the largest change (p large, Lawson's reweighting).
-constexpr Real kLastExponent = 16;
 constexpr Real kLargestStep = 0.1;    // rad: one round moves no joint further
 constexpr int kHalvings = 5;          // of a step that does not lower the norm
 constexpr Real kFloorChange = 1e-4;   // rad: changes below this weigh as this
@@ -43,7 +42,7 @@ void solve_tridiagonal(const std::vector<Real>& d, const std::vector<Real>& o, R
 
 bool even_stance(const LegChain& chain, const Vec2d* goals, int count, const Real* before, const Real* after,
                  const std::vector<char>& counted, std::vector<Real>& angles, std::vector<Real>& errors,
-                 Real tolerance, const std::vector<Real>& allowed, int iterations) {
+                 Real tolerance, const std::vector<Real>& allowed, int iterations, Real last_exponent) {
   const int n = chain.size();
   if (count < 2) return false;
   const int changes = after ? count + 1 : count;  // change j goes into frame j (count: into `after`)
@@ -85,7 +84,7 @@ bool even_stance(const LegChain& chain, const Vec2d* goals, int count, const Rea
   std::vector<MatX> hinv(n, MatX(count, count));
   Vec2 points[kMaxBones + 1];
   for (int round = 0; round < kRounds; ++round) {
-    const Real p = 2 + (kLastExponent - 2) * std::min(Real(1), Real(round) / (kRounds / 2));
+    const Real p = 2 + (last_exponent - 2) * std::min(Real(1), Real(round) / (kRounds / 2));
     Real top = kFloorChange / counted_top;
     for (int j = 0; j < changes; ++j) {
       for (int b = 0; b < n; ++b) top = std::max(top, scaled(theta, j, b));
@@ -177,7 +176,7 @@ bool even_stance(const LegChain& chain, const Vec2d* goals, int count, const Rea
     }
     if (!improved) {
       theta = from;
-      if (p >= kLastExponent) break;  // settled at the last exponent
+      if (p >= last_exponent) break;  // settled at the last exponent
       continue;                       // a larger exponent may still move
     }
     const Real turn = largest(theta, true);

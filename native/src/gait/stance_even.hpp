@@ -14,10 +14,11 @@ namespace kodawari::gait::stages {
 // `counted[j]` marks the changes whose peak is lowered (change j goes into frame j, change
 // `count` into `after`): the others are only kept from growing past their own largest.
 // Iteratively reweighted least squares (Lawson) with a constrained Gauss-Newton step per
-// round. Keeps the result (its misses in `errors`) only if its largest counted change is
+// round, the norm's exponent raised from 2 to `last_exponent` (16: near the largest
+// change itself). Keeps the result (its misses in `errors`) only if its largest counted change is
 // smaller and every foot is within `allowed[i]` (or as close as before).
 bool even_stance(const LegChain& chain, const Vec2d* goals, int count, const Real* before, const Real* after,
                  const std::vector<char>& counted, std::vector<Real>& angles, std::vector<Real>& errors,
-                 Real tolerance, const std::vector<Real>& allowed, int iterations);
+                 Real tolerance, const std::vector<Real>& allowed, int iterations, Real last_exponent = 16);
 
 }  // namespace kodawari::gait::stages
