@@ -641,6 +641,9 @@ class LegIk {
     const Real rule_before = std::max(rule(), Real(1));
     for (int k = 0; k < count; ++k) record(start + k, goals3[k], angles.data() + k * n_, errors[k]);
     if (rule() <= rule_before) return true;
+    // Broken at the lift-off only beside a slow first swing change: carried on into the swing.
+    if (end > stance.last && lift_off_carries_on(i) && rule() <= rule_before) return true;
+    for (int k = 0; k < count; ++k) record(start + k, goals3[k], angles.data() + k * n_, errors[k]);
     for (Real w : kEvenBlends) {  // part of the way, each frame put back on its goal
       bool held = true;
       for (int k = 0; k < count && held; ++k) {
