@@ -94,9 +94,9 @@ class LegIk {
       }
       changed.swap(next);
     }
-    // Last, a stance whose joint turns faster than kSnapRate, or whose ends break the 3x
-    // rule, is evened out with the swings either side of it (docs/algorithms.md §4.8,
-    // "The fastest joint of a stance").
+    // Last, a stance whose joint turns faster than kSnapRate, or that breaks the 3x rule,
+    // is evened out with the swings either side of it (docs/algorithms.md §4.8, "The
+    // fastest joint of a stance").
     for (std::size_t i = 0; i < spans_.size(); ++i) {
       if (spans_[i].planted) even_out_stance(i);
     }
@@ -583,7 +583,7 @@ class LegIk {
   // The stance spans_[i] re-solved with the last kEvenSwingShare of the swing before it
   // and the first of the swing after it for the least largest joint change between
   // frames (stance_even.cpp), where a planted joint turns faster than kSnapRate or a
-  // change at its touch-down or lift-off breaks the issue's 3x rule: the swing then lands
+  // planted change (the touch-down's included) breaks the issue's 3x rule: the swing then lands
   // in a configuration its stance carries on from, and the stance's fastest joint is
   // slowed. Kept, or else the part of the way to it that is, or else the same evened out
   // less sharply (kEvenRetryExponent), only if it breaks the 3x rule at no planted frame
@@ -600,10 +600,10 @@ class LegIk {
       }
       return turn;
     };
-    Real ends = 0;  // the worst ratio to the 3x rule at its frames (its touch-down included)
-    for (int f = stance.first; f < stance.last; ++f) ends = std::max(ends, snap_ratio(f));
+    Real worst_ratio = 0;  // to the 3x rule at its planted frames (its touch-down included)
+    for (int f = stance.first; f < stance.last; ++f) worst_ratio = std::max(worst_ratio, snap_ratio(f));
     const Real turn_before = largest_step(stance.first, stance.last);
-    if (turn_before <= kSnapRate / in_.fps && ends <= 1) return false;
+    if (turn_before <= kSnapRate / in_.fps && worst_ratio <= 1) return false;
     auto share = [](const Span& s) {
       return std::clamp(static_cast<int>(std::lround((s.last - s.first) * kEvenSwingShare)), 0, s.last - s.first - 1);
     };
