@@ -15,9 +15,10 @@ using MatX = Eigen::Matrix<Real, Eigen::Dynamic, Eigen::Dynamic>;
 using VecX = Eigen::Matrix<Real, Eigen::Dynamic, 1>;
 
 // Outer iterations: each reweights the changes and takes one constrained Gauss-Newton step.
+// The norm's exponent rises over the first half of them from a plain least squares
+// smoothing (p = 2, a geodesic-like path) towards the largest change (p large: Lawson's
+// reweighting), and stays there.
 constexpr int kRounds = 40;
-// The norm's exponent rises over the rounds from a plain least squares smoothing (p = 2,
-// a geodesic-like path) towards the largest change (p large, Lawson's reweighting).
 constexpr Real kLargestStep = 0.1;    // rad: one round moves no joint further
 constexpr int kHalvings = 5;          // of a step that does not lower the norm
 constexpr Real kFloorChange = 1e-4;   // rad: changes below this weigh as this
