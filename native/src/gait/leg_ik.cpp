@@ -648,7 +648,10 @@ class LegIk {
       bool held = true;
       for (int k = 0; k < count && held; ++k) {
         Real pose[kMaxBones];
-        for (int b = 0; b < n_; ++b) pose[b] = old_angles[k * n_ + b] + w * (angles[k * n_ + b] - old_angles[k * n_ + b]);
+        for (int b = 0; b < n_; ++b) {
+          const Real was = old_angles[k * n_ + b];
+          pose[b] = was + w * (angles[k * n_ + b] - was);
+        }
         const Real error = solve_dls(chain_, goals[k], kEvenIterations, kIkTolerance, pose).error;
         held = error <= std::max(old_errors[k], allowed[k]);
         record(start + k, goals3[k], pose, error);
