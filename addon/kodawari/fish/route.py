@@ -301,15 +301,25 @@ def install(obj, rig):
     return mod
 
 
+def has_attribute(mesh, name):
+    """The mesh has an attribute of that name, asked without touching its values. Blender
+    4+ shares a mesh's arrays with its evaluated copy; `attributes.get(name)` and `name in
+    attributes` hand out a writable attribute, so Blender first gives the user's mesh a copy
+    of its own (12 bytes per vertex for the bound coordinates, kept while the evaluated copy
+    lives: every frame of playback). `find` only compares names."""
+    return mesh.attributes.find(name) >= 0
+
+
 def installed_for(obj, rig):
-    """True when the object's route was installed for this very rig (same binding)."""
+    """True when the object's route was installed for this very rig (same binding). Asked
+    every frame: it reads nothing per vertex and copies nothing (has_attribute)."""
     mod = modifier(obj)
     if mod is None or getattr(rig, "installed_on", None) != obj.data.as_pointer():
         return False
     mesh = obj.data
     return (
-        mesh.attributes.get(COORDINATES) is not None
-        and (rig.fin_vertices is None) == (mesh.attributes.get(FIN_INDEX) is None)
+        has_attribute(mesh, COORDINATES)
+        and (rig.fin_vertices is None) != has_attribute(mesh, FIN_INDEX)
         # shape keys added or removed since: the tree reads their offset, or not
         and bool(mod.node_group.get("kodawari_with_keys")) == (mesh.shape_keys is not None)
     )
