@@ -8,8 +8,8 @@ wall time), the parts interleaved round by round as in every benchmark here:
   handler         runtime.evaluate alone: body axis, frame table, the helper's write
   helper          writing and tagging the helper, its evaluation and an empty pass of the
                   modifier (a tree that passes the mesh through, still depending on the helper)
-  set_position    the Fish Swim tree cut down to Set Position from the bound attribute
-  first_sample    ... plus Separate XYZ, Floor and one Sample Index on the helper
+  set_position    the Fish Swim tree cut down to Set Position from one bound attribute
+  first_sample    ... plus Floor and one Sample Index on the helper
   fish_swim       the whole Fish Swim tree, as it plays (docs/algorithms.md §1.6)
   + normals       the same frame with the evaluated vertex normals read (as a viewport does)
   geometry_nodes  the Geometry Nodes bend's frame of bench_fish.py (its curve's animation and
@@ -45,19 +45,20 @@ def cut_down_group(table_obj, part):
     geometry = tree.node("NodeGroupInput").outputs[0]
     table = tree.object_geometry("frames", table_obj)  # the helper, a dependency in every part
     if part != "helper":
+        s = tree.named(route.COORDINATES[0], "FLOAT")
         if part == "set_position":
-            position = tree.named(route.COORDINATES, "FLOAT_VECTOR")
+            position = s  # one bound attribute, as a vector (s, s, s)
         else:
-            split = tree.node("ShaderNodeSeparateXYZ")
-            tree.links.new(tree.named(route.COORDINATES, "FLOAT_VECTOR"), split.inputs[0])
-            position = tree.sample(table, "o", tree.math("FLOOR", split.outputs["X"], 0.0))
+            position = tree.sample(table, "o", tree.math("FLOOR", s, 0.0))
         set_position = tree.node("GeometryNodeSetPosition")
         tree.links.new(geometry, set_position.inputs["Geometry"])
         tree.links.new(position, set_position.inputs["Position"])
-        remove = tree.node("GeometryNodeRemoveAttribute")
-        remove.inputs["Name"].default_value = route.COORDINATES
-        tree.links.new(set_position.outputs[0], remove.inputs["Geometry"])
-        geometry = remove.outputs[0]
+        geometry = set_position.outputs[0]
+        for name in route.COORDINATES:
+            remove = tree.node("GeometryNodeRemoveAttribute")
+            remove.inputs["Name"].default_value = name
+            tree.links.new(geometry, remove.inputs["Geometry"])
+            geometry = remove.outputs[0]
     tree.links.new(geometry, tree.node("NodeGroupOutput").inputs[0])
     return group
 
