@@ -182,6 +182,11 @@ class ArmatureRuntime:
         self.predictor = None  # built at the first new frame (predict.PosePredictor)
         self.prediction_off = None  # why this rig's frames are not predicted, once known
         self.predicted = None  # the prediction made before the pass, until checked after it
+        # The next frame solved ahead on native threads (_start_ahead): native.RodStepAhead,
+        # its bone matrices, and what it was started from, until _take_ahead looks at it.
+        self.ahead = None
+        self.ahead_matrices = None
+        self.ahead_inputs = None
         self.rotation_view = None  # bulk.PoseRotationView once built, False when refused
         self.matrix_bones = (
             sorted(read) if len(read) * SPARSE_READ_RATIO <= self.bone_count else None
@@ -325,7 +330,9 @@ class ArmatureRuntime:
     def _predict(self, obj, scene, frame):
         """Solves the frame after the last simulated one from inputs predicted before Blender
         evaluates it (predict.py); evaluate() checks them against Blender's after the pass.
-        False (nothing changed) when this rig's or this frame's inputs cannot be predicted."""
+        False (nothing changed) when this rig's or this frame's inputs cannot be predicted.
+        The next frame is then solved ahead, on native threads, while Blender evaluates this
+        one (_start_ahead); the next call takes that result when it is what it would solve."""
         if self.predicted is not None:
             return False  # an earlier prediction was never checked: evaluate() sorts it out
         previous = self._previous_frame(frame)
@@ -337,23 +344,14 @@ class ArmatureRuntime:
             except predict.Unpredictable as exc:
                 self.prediction_off = str(exc)
                 return False
-        time = scene.frame_current_final
-        camera = active_camera(scene, frame)
-        camera_position = None
-        if camera is not None and self.view_keys:
-            camera_position = self.predictor.camera_position(camera, time)
-            if camera_position is None:
-                return False  # a camera moved by more than its own action: this frame only
-        elif camera is not None:  # no view keys: the camera's position changes nothing
-            camera_position = np.array(camera.matrix_world.translation, np.float64)
-        try:
-            matrices, armature_matrix = self.predictor.predict(time)
-        except (predict.Unpredictable, ValueError) as exc:
-            self.prediction_off = str(exc)
+        inputs = self._predicted_inputs(scene, frame, scene.frame_current_final)
+        if inputs is None:
             return False
-        gravity = _gravity(scene)
+        matrices, armature_matrix, camera_position, gravity = inputs
         self.matrices[self.input_bones] = matrices
-        self._step(scene, previous, frame, armature_matrix, camera_position, gravity)
+        fps = _fps(scene)
+        if not self._take_ahead(frame, previous, inputs, fps):
+            self._step(scene, previous, frame, armature_matrix, camera_position, gravity)
         self.predicted = predict.Prediction(
             frame,
             previous,
@@ -364,8 +362,79 @@ class ArmatureRuntime:
             self.rotations,
             self.view_keys,
         )
-        self.status = "" if camera is not None else NO_CAMERA
+        self.status = "" if active_camera(scene, frame) is not None else NO_CAMERA
+        self._start_ahead(scene, frame + 1, fps)
         return True
+
+    def _predicted_inputs(self, scene, frame, time, ahead=False):
+        """(input bone matrices, armature matrix, camera position, gravity) predicted for
+        `frame` at scene time `time`, or None when this frame's camera cannot be predicted or
+        the rig turns out unpredictable (then prediction_off says why, unless only looking
+        `ahead`: the frame itself will find out if it is ever played)."""
+        camera = active_camera(scene, frame)
+        camera_position = None
+        if camera is not None and self.view_keys:
+            camera_position = self.predictor.camera_position(camera, time)
+            if camera_position is None:
+                return None  # a camera moved by more than its own action: this frame only
+        elif camera is not None:  # no view keys: the camera's position changes nothing
+            camera_position = np.array(camera.matrix_world.translation, np.float64)
+        try:
+            matrices, armature_matrix = self.predictor.predict(time)
+        except (predict.Unpredictable, ValueError) as exc:
+            if not ahead:
+                self.prediction_off = str(exc)
+            return None
+        return matrices, armature_matrix, camera_position, _gravity(scene)
+
+    def _start_ahead(self, scene, frame, fps):
+        """Starts solving `frame` (the one after the frame just solved) on native threads from
+        its predicted inputs, while Blender evaluates the frame just written (docs/algorithms.md
+        §3.7). Nothing of it is used unless _take_ahead finds it is exactly what `frame` would
+        solve. Skipped past the scene's end (playback wraps to the start, which resets)."""
+        self.ahead_inputs = None
+        if frame > scene.frame_end:
+            return
+        inputs = self._predicted_inputs(scene, frame, float(frame), ahead=True)
+        if inputs is None:
+            return
+        matrices, armature_matrix, camera_position, gravity = inputs
+        if self.ahead is None:
+            self.ahead = native.module().RodStepAhead()
+            self.ahead_matrices = self.matrices.copy()
+        self.ahead_matrices[self.input_bones] = matrices  # the rods read these rows only
+        try:
+            self.ahead.start(
+                self.system,
+                self.ahead_matrices,
+                armature_matrix,
+                camera_position,
+                gravity,
+                frame / fps,
+                1 / fps,
+            )
+        except ValueError:
+            return  # inputs the solver refuses: the frame itself says so if it is ever played
+        self.ahead_inputs = (frame, frame - 1, inputs, fps)  # stepped from the frame just solved
+
+    def _take_ahead(self, frame, previous, inputs, fps):
+        """True when the frame solved ahead (_start_ahead) is `frame`, stepped from the state this
+        system holds (`previous`, unchanged since: the native side checks its state revision)
+        with exactly these inputs: its rotations are then in self.rotations and its state is the
+        system's, bit for bit what _step would have made. False otherwise (it is dropped)."""
+        ahead, self.ahead_inputs = self.ahead_inputs, None
+        if ahead is None:
+            return False
+        ahead_frame, ahead_previous, ahead_inputs, ahead_fps = ahead
+        if (
+            ahead_frame != frame
+            or ahead_previous != previous
+            or self.last_frame != previous
+            or ahead_fps != fps
+            or not _same_inputs(ahead_inputs, inputs)
+        ):
+            return False
+        return self.ahead.finish(self.rotations) and self.ahead.adopt(self.system)
 
     def _step(self, scene, previous, frame, armature_matrix, camera, gravity):
         """Simulates from the stored frame `previous` (recalled unless it is the state held)
@@ -501,6 +570,14 @@ class ArmatureRuntime:
         if slot is None or self.last_frame is None:
             return None
         return self.system.weights(slot)
+
+
+def _same_inputs(a, b):
+    """Two frames' predicted inputs (matrices, armature matrix, camera or None, gravity) are
+    bit for bit the same."""
+    if (a[2] is None) != (b[2] is None):
+        return False
+    return all(x is None or np.array_equal(x, y) for x, y in zip(a, b))
 
 
 def _fps(scene):

@@ -3,6 +3,7 @@
 #include "kodawari/rod/rod_system.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <stdexcept>
 #include <string>
 
@@ -12,6 +13,15 @@
 namespace kodawari::rod {
 
 using namespace detail;
+
+namespace {
+// Definition revisions are unique in the process, so a system built where a freed one lived
+// never passes for it (RodStepAhead).
+std::uint64_t next_definition_revision() {
+  static std::atomic<std::uint64_t> counter{0};
+  return ++counter;
+}
+}  // namespace
 
 void bone_transform(const float* bone_matrices, std::size_t index, Quat& rotation, Vec3& position,
                     Eigen::Matrix<Real, 3, 3>* linear) {
@@ -80,6 +90,8 @@ std::size_t RodSystem::add_rod(RodDefinition rod) {
   states_.emplace_back();
   weights_.emplace_back(rods_.back().keys.size() + 1, Real(0));
   weights_.back()[0] = 1;
+  definition_revision_ = next_definition_revision();
+  ++state_revision_;
   return rods_.size() - 1;
 }
 
@@ -93,6 +105,7 @@ void RodSystem::set_colliders(std::vector<ColliderDefinition> colliders) {
     }
   }
   colliders_ = std::move(colliders);
+  definition_revision_ = next_definition_revision();
 }
 
 std::vector<Collider> RodSystem::world_colliders(const FrameInput& input) const {
@@ -133,6 +146,7 @@ void RodSystem::write_output(std::size_t r, float* rotations_out) {
 }
 
 void RodSystem::reset(const FrameInput& input, float* rotations_out) {
+  ++state_revision_;
   const std::vector<Collider> colliders = world_colliders(input);
   parallel_for_dynamic(rods_.size(), threads_, kRodsPerChunk, [&](std::size_t begin, std::size_t end) {
     for (std::size_t r = begin; r < end; ++r) {
@@ -143,6 +157,7 @@ void RodSystem::reset(const FrameInput& input, float* rotations_out) {
 }
 
 void RodSystem::step(const FrameInput& input, float* rotations_out) {
+  ++state_revision_;
   const std::vector<Collider> colliders = world_colliders(input);
   parallel_for_dynamic(rods_.size(), threads_, kRodsPerChunk, [&](std::size_t begin, std::size_t end) {
     for (std::size_t r = begin; r < end; ++r) {
@@ -166,6 +181,34 @@ Vec3List RodSystem::joint_velocities(std::size_t r) const {
   return Vec3List(s.v.begin() + 1, s.v.end());
 }
 
+
+std::unique_ptr<RodSystem> RodSystem::twin(unsigned threads) const {
+  auto twin = std::make_unique<RodSystem>(bone_count_, threads);
+  twin->rods_ = rods_;
+  twin->colliders_ = colliders_;
+  twin->states_ = states_;
+  twin->weights_ = weights_;
+  return twin;
+}
+
+void RodSystem::copy_state_from(const RodSystem& twin) {
+  if (twin.rods_.size() != rods_.size() || twin.bone_count_ != bone_count_) {
+    throw std::invalid_argument("copy_state_from: not a twin of this system");
+  }
+  states_ = twin.states_;  // same sizes: the vectors keep their memory, no allocation
+  weights_ = twin.weights_;
+  ++state_revision_;
+}
+
+void RodSystem::swap_state(RodSystem& twin) {
+  if (twin.rods_.size() != rods_.size() || twin.bone_count_ != bone_count_) {
+    throw std::invalid_argument("swap_state: not a twin of this system");
+  }
+  states_.swap(twin.states_);
+  weights_.swap(twin.weights_);
+  ++state_revision_;
+  ++twin.state_revision_;
+}
 
 std::size_t RodSystem::rod_bone_count() const {
   std::size_t count = 0;

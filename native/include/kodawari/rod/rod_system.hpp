@@ -19,6 +19,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -171,6 +172,18 @@ class RodSystem {
   // Number of rod bones (rows of a cached frame's rotations).
   std::size_t rod_bone_count() const;
 
+  // Counters of change, for RodStepAhead (rod_step_ahead.hpp): the state revision moves with
+  // every change of the simulation state (reset, step, a loaded or recalled state, an exchange),
+  // the definition revision with every change of the rods or colliders.
+  std::uint64_t state_revision() const { return state_revision_; }
+  std::uint64_t definition_revision() const { return definition_revision_; }
+  // A system with the same rods, colliders and state, without cached frames (a copy, not
+  // re-added rods: add_rod normalises, and a twin must step bit for bit as this system does).
+  std::unique_ptr<RodSystem> twin(unsigned threads) const;
+  // The simulation state of a twin copied into this system, or exchanged with it (no copy).
+  void copy_state_from(const RodSystem& twin);
+  void swap_state(RodSystem& twin);
+
  private:
   void begin_frame(std::size_t r, const FrameInput& input, const std::vector<Collider>& colliders, bool reset);
   void simulate(std::size_t r, const FrameInput& input, const std::vector<Collider>& colliders);
@@ -189,6 +202,8 @@ class RodSystem {
   std::vector<std::vector<Real>> weights_;
   std::vector<ColliderDefinition> colliders_;
   FrameCache cache_;
+  std::uint64_t state_revision_ = 0;
+  std::uint64_t definition_revision_ = 0;
 };
 
 // Matrix of pose bone `index` from the foreach_get buffer, with rotation and position.

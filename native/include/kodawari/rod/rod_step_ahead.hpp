@@ -1,0 +1,60 @@
+// The next frame of a RodSystem, stepped on a worker thread while the caller does other work
+// (docs/algorithms.md §3.7: the hair's next frame is solved while Blender evaluates this one).
+//
+// start() copies the system's state into a twin (same rods, same colliders, no cache) and steps
+// the twin by the given input on its own thread; the system itself is not touched, so it can be
+// read, cached and stepped meanwhile. finish() waits and hands out the rotations; adopt() gives
+// the system the stepped state by exchange, and only when the system still holds the state the
+// step started from (its state revision has not moved) and its rods are the twin's. The step is
+// the system's own step on an exact copy: what adopt() gives is bit for bit what the system's
+// step() with the same input would have given (the rod solver's results never depend on the
+// thread count, parallel.hpp).
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <thread>
+#include <vector>
+
+#include "kodawari/rod/rod_system.hpp"
+
+namespace kodawari::rod {
+
+class RodStepAhead {
+ public:
+  explicit RodStepAhead(unsigned threads = 0) : threads_(threads) {}
+  ~RodStepAhead() { wait(); }
+  RodStepAhead(const RodStepAhead&) = delete;
+  RodStepAhead& operator=(const RodStepAhead&) = delete;
+
+  // Waits for an earlier step, copies `system`'s state (its rods and colliders too when they
+  // changed) and `input` (the bone matrices included), and starts the step. Returns at once.
+  void start(const RodSystem& system, const FrameInput& input);
+  // Waits for the step. True when it ran and every rod bone's rotation is finite; those rows
+  // (rod bones only) are then written into rotations_out (bone_count x 4).
+  bool finish(float* rotations_out);
+  // After a successful finish(): exchanges the stepped state into `system` when it is the system
+  // the step started from and still holds that state. False (nothing changes) otherwise.
+  bool adopt(RodSystem& system);
+  // A step is running or waits to be finished.
+  bool started() const { return worker_.joinable() || stepped_; }
+  // Bones of the system the last start() copied (0 before any).
+  std::size_t bone_count() const { return twin_ ? twin_->bone_count() : 0; }
+
+ private:
+  void wait();
+
+  unsigned threads_;
+  std::unique_ptr<RodSystem> twin_;
+  const RodSystem* source_ = nullptr;
+  std::uint64_t definition_ = 0;  // source_'s definition revision the twin was copied from
+  std::uint64_t state_ = 0;       // source_'s state revision the step started from
+  std::vector<float> matrices_;
+  std::vector<float> rotations_;
+  FrameInput input_;
+  std::thread worker_;
+  bool stepped_ = false;  // the worker ran (joined or not)
+  bool finite_ = false;
+};
+
+}  // namespace kodawari::rod
