@@ -127,6 +127,8 @@ def _play_session(head_by, ahead):
         return used
 
     runtime.ArmatureRuntime._take_ahead = spy
+    min_bones = runtime.AHEAD_MIN_ROD_BONES
+    runtime.AHEAD_MIN_ROD_BONES = 0  # this small rig solved ahead as a large one is
     if not ahead:  # the plain path: every frame solved in its own handler
         runtime.ArmatureRuntime._start_ahead = lambda *args: None
     seen, taken_per_set = [], {}
@@ -141,6 +143,7 @@ def _play_session(head_by, ahead):
     finally:
         runtime.ArmatureRuntime._take_ahead = take
         runtime.ArmatureRuntime._start_ahead = start
+        runtime.AHEAD_MIN_ROD_BONES = min_bones
     return seen, taken_per_set
 
 

@@ -61,6 +61,21 @@ def active_camera(scene, frame):
     return min(markers, key=lambda m: m.frame).camera
 
 
+# The next frame is solved ahead, while Blender evaluates this one (_start_ahead), on every
+# core but one: Blender's evaluation of a pose keeps to about one core (3.4, 16,000 bones: 31 ms
+# of processor time in 43 ms), so both run side by side. Only for rigs of at least
+# AHEAD_MIN_ROD_BONES rod bones: below, Blender's evaluation (under 1 ms at 1,600 bones) is too
+# short to hide a step in, and handing the step to another thread and back costs more than it
+# saves (measured at 160 and 1,600 bones: tests/bench/bench_hair.py, docs/algorithms.md §3.7).
+AHEAD_MIN_ROD_BONES = 4096
+
+
+def _ahead_threads():
+    import os
+
+    return max(1, (os.cpu_count() or 2) - 1)
+
+
 # Reading a few bones one by one beats a foreach_get over all of them when they are
 # fewer than 1 in this many (~5 us per bone against ~0.03 us per bone in bulk).
 SPARSE_READ_RATIO = 256
@@ -393,14 +408,14 @@ class ArmatureRuntime:
         §3.7). Nothing of it is used unless _take_ahead finds it is exactly what `frame` would
         solve. Skipped past the scene's end (playback wraps to the start, which resets)."""
         self.ahead_inputs = None
-        if frame > scene.frame_end:
+        if frame > scene.frame_end or len(self.rod_bones) < AHEAD_MIN_ROD_BONES:
             return
         inputs = self._predicted_inputs(scene, frame, float(frame), ahead=True)
         if inputs is None:
             return
         matrices, armature_matrix, camera_position, gravity = inputs
         if self.ahead is None:
-            self.ahead = native.module().RodStepAhead()
+            self.ahead = native.module().RodStepAhead(_ahead_threads())
             self.ahead_matrices = self.matrices.copy()
         self.ahead_matrices[self.input_bones] = matrices  # the rods read these rows only
         try:
