@@ -1,5 +1,7 @@
 // RodSystem's lifecycle: validating and adding rods and colliders, reset and step
-// over every rod (in parallel), and writing each bone's rotation.
+// over every rod (in parallel), and writing each bone's rotation. The rods go to the
+// process's kept worker threads (worker_pool.hpp), not to threads started per call: a frame
+// does not wait for a thread the machine has not scheduled yet.
 #include "kodawari/rod/rod_system.hpp"
 
 #include <algorithm>
@@ -7,7 +9,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "kodawari/parallel.hpp"
+#include "kodawari/worker_pool.hpp"
 #include "rod_detail.hpp"
 
 namespace kodawari::rod {
@@ -148,7 +150,7 @@ void RodSystem::write_output(std::size_t r, float* rotations_out) {
 void RodSystem::reset(const FrameInput& input, float* rotations_out) {
   ++state_revision_;
   const std::vector<Collider> colliders = world_colliders(input);
-  parallel_for_dynamic(rods_.size(), threads_, kRodsPerChunk, [&](std::size_t begin, std::size_t end) {
+  parallel_chunks(rods_.size(), threads_, kRodsPerChunk, [&](std::size_t begin, std::size_t end) {
     for (std::size_t r = begin; r < end; ++r) {
       begin_frame(r, input, colliders, true);
       if (rotations_out) write_output(r, rotations_out);
@@ -159,7 +161,7 @@ void RodSystem::reset(const FrameInput& input, float* rotations_out) {
 void RodSystem::step(const FrameInput& input, float* rotations_out) {
   ++state_revision_;
   const std::vector<Collider> colliders = world_colliders(input);
-  parallel_for_dynamic(rods_.size(), threads_, kRodsPerChunk, [&](std::size_t begin, std::size_t end) {
+  parallel_chunks(rods_.size(), threads_, kRodsPerChunk, [&](std::size_t begin, std::size_t end) {
     for (std::size_t r = begin; r < end; ++r) {
       const bool fresh = !states_[r].initialised;
       begin_frame(r, input, colliders, fresh);
