@@ -387,18 +387,37 @@ void bind_rod(py::module_& m) {
           "start",
           [](RodStepAhead& self, const RodSystem& system, const py::handle& bone_matrices,
              const py::handle& armature_matrix, const py::handle& camera, const py::handle& gravity, double time,
-             double frame_dt) {
+             double frame_dt, const py::handle& rotations) {
             py::array_t<float> keep;
             const FrameInput in =
                 frame_input(system, bone_matrices, armature_matrix, camera, gravity, time, frame_dt, keep);
+            py::array_t<float> rows;
+            if (!rotations.is_none()) {
+              rows = checked_array<float>(rotations, "rotations", static_cast<py::ssize_t>(system.bone_count()), 4);
+            }
+            const ExclusiveUse use_system = exclusive(system);
+            const ExclusiveUse use(&self, "RodStepAhead");
+            const float* rows_data = rotations.is_none() ? nullptr : rows.data();
+            py::gil_scoped_release release;
+            self.start(system, in, rows_data);
+          },
+          py::arg("system"), py::arg("bone_matrices"), py::arg("armature_matrix"), py::arg("camera"),
+          py::arg("gravity"), py::arg("time"), py::arg("frame_dt"), py::arg("rotations") = py::none(),
+          "Starts system.step(...) with these inputs on a copy of its state; returns at once. With rotations\n"
+          "(B, 4) float32, the rotations the system's state was written with, the thread first makes the\n"
+          "frame-cache snapshot of that state for store().")
+      .def(
+          "store",
+          [](RodStepAhead& self, RodSystem& system, int frame) {
             const ExclusiveUse use_system = exclusive(system);
             const ExclusiveUse use(&self, "RodStepAhead");
             py::gil_scoped_release release;
-            self.start(system, in);
+            return self.store(system, frame);
           },
-          py::arg("system"), py::arg("bone_matrices"), py::arg("armature_matrix"), py::arg("camera"),
-          py::arg("gravity"), py::arg("time"), py::arg("frame_dt"),
-          "Starts system.step(...) with these inputs on a copy of its state; returns at once.")
+          py::arg("system"), py::arg("frame"),
+          "system.store_frame(frame, rotations) with the snapshot start() had made on its thread, when the\n"
+          "system still holds the state it was made of; waits for the snapshot only. False, nothing cached,\n"
+          "otherwise.")
       .def(
           "finish",
           [](RodStepAhead& self, const py::handle& rotations_out) {

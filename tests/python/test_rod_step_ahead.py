@@ -135,3 +135,32 @@ def test_a_step_ahead_refuses_bad_inputs_before_it_starts():
     with pytest.raises(ValueError, match="armature_matrix"):
         ahead.start(system, **bad)
     assert not ahead.started
+
+
+def test_the_snapshot_made_on_the_thread_caches_the_frame_bit_for_bit_as_store_frame_does():
+    played, out = _started(frames=3)
+    ahead_system, ahead_out = _started(frames=3)
+    ahead = kn.RodStepAhead()
+    ahead.start(ahead_system, rotations=ahead_out, **_inputs(5))
+    played.store_frame(4, out)
+    assert ahead.store(ahead_system, 4)
+    assert not ahead.store(ahead_system, 4), "one snapshot per start"
+    np.testing.assert_array_equal(ahead_system.cached_state(4), played.cached_state(4))
+    np.testing.assert_array_equal(ahead_system.cached_rotations(4), played.cached_rotations(4))
+    # Stepping on from the cached frame gives what the played system gives.
+    assert ahead.finish(ahead_out) and ahead.adopt(ahead_system)
+    played.step(rotations_out=out, **_inputs(5))
+    ahead_system.recall_frame(4)
+    ahead_system.step(rotations_out=ahead_out, **_inputs(5))
+    np.testing.assert_array_equal(ahead_out, out)
+
+
+def test_a_snapshot_of_a_state_the_system_no_longer_holds_is_not_cached():
+    system, out = _started()
+    ahead = kn.RodStepAhead()
+    ahead.start(system, rotations=out, **_inputs(3))
+    system.step(rotations_out=out, **_inputs(3))  # the system moved on
+    assert not ahead.store(system, 2)
+    assert system.cached_frames() == []
+    ahead.start(system, **_inputs(4))  # no rotations: no snapshot
+    assert not ahead.store(system, 3)

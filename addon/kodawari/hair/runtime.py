@@ -427,6 +427,7 @@ class ArmatureRuntime:
                 gravity,
                 frame / fps,
                 1 / fps,
+                self.rotations,  # the frame just solved: cached from the thread's snapshot (_store)
             )
         except ValueError:
             return  # inputs the solver refuses: the frame itself says so if it is ever played
@@ -485,9 +486,16 @@ class ArmatureRuntime:
         if wrong is not None:
             self.prediction_off = wrong
             self._step(scene, prediction.previous, frame, armature_matrix, camera, gravity)
-        self.system.store_frame(frame, self.rotations)
+        self._store(frame)
         self._write(obj, depsgraph)
         return True
+
+    def _store(self, frame):
+        """Caches `frame`, the state the system holds: with the snapshot the step ahead made of
+        this very state on its own thread (off this frame's path) when there is one, else now."""
+        ahead = self.ahead_inputs
+        if ahead is None or ahead[1] != frame or not self.ahead.store(self.system, frame):
+            self.system.store_frame(frame, self.rotations)
 
     def _write_evaluated(self, obj, frame, changed=None):
         """Writes the rotations into the viewport's evaluated armature too: when the frame change

@@ -10,9 +10,17 @@ void RodStepAhead::wait() {
   if (worker_.joinable()) worker_.join();
 }
 
-void RodStepAhead::start(const RodSystem& system, const FrameInput& input) {
+bool RodStepAhead::same_state(const RodSystem& system) const {
+  return source_ == &system && system.state_revision() == state_ && system.definition_revision() == definition_;
+}
+
+void RodStepAhead::start(const RodSystem& system, const FrameInput& input, const float* rotations) {
   wait();
   stepped_ = finite_ = false;
+  snapshot_ = FrameCache::Entry{};
+  snapshot_made_ = false;
+  snapshot_wanted_ = rotations != nullptr;
+  if (snapshot_wanted_) snapshot_rotations_.assign(rotations, rotations + 4 * system.bone_count());
   if (!twin_ || source_ != &system || definition_ != system.definition_revision()) {
     twin_ = system.twin(threads_);
     source_ = &system;
@@ -29,6 +37,19 @@ void RodStepAhead::start(const RodSystem& system, const FrameInput& input) {
   worker_ = std::thread([this] {
     bool finite = false;
     try {
+      if (snapshot_wanted_) {
+        FrameCache::Entry entry = twin_->snapshot(snapshot_rotations_.data());
+        std::lock_guard<std::mutex> lock(mutex_);
+        snapshot_ = std::move(entry);
+      }
+    } catch (...) {  // an allocation failure: no snapshot; store() says so and the caller copies
+    }
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      snapshot_made_ = true;
+    }
+    made_.notify_all();
+    try {
       twin_->step(input_, rotations_.data());
       finite = std::all_of(rotations_.begin(), rotations_.end(), [](float v) { return std::isfinite(v); });
     } catch (...) {  // an allocation failure: no result; the caller steps the system itself
@@ -37,6 +58,21 @@ void RodStepAhead::start(const RodSystem& system, const FrameInput& input) {
     finite_ = finite;
     stepped_ = true;
   });
+}
+
+bool RodStepAhead::store(RodSystem& system, int frame) {
+  if (!snapshot_wanted_ || !same_state(system)) return false;
+  FrameCache::Entry entry;
+  {
+    std::unique_lock<std::mutex> lock(mutex_);
+    made_.wait(lock, [&] { return snapshot_made_; });
+    if (!snapshot_.state) return false;
+    entry = std::move(snapshot_);
+    snapshot_ = FrameCache::Entry{};
+  }
+  snapshot_wanted_ = false;  // one store per start
+  system.store_snapshot(frame, std::move(entry));
+  return true;
 }
 
 bool RodStepAhead::finish(float* rotations_out) {
@@ -53,9 +89,7 @@ bool RodStepAhead::finish(float* rotations_out) {
 
 bool RodStepAhead::adopt(RodSystem& system) {
   wait();
-  const bool same = stepped_ && finite_ && source_ == &system && system.state_revision() == state_ &&
-                    system.definition_revision() == definition_;
-  if (!same) return false;
+  if (!(stepped_ && finite_ && same_state(system))) return false;
   system.swap_state(*twin_);
   stepped_ = finite_ = false;  // the twin now holds the old state: the next start() copies afresh
   return true;

@@ -3,7 +3,9 @@
 //
 // start() copies the system's state into a twin (same rods, same colliders, no cache) and steps
 // the twin by the given input on its own thread; the system itself is not touched, so it can be
-// read, cached and stepped meanwhile. finish() waits and hands out the rotations; adopt() gives
+// read, cached and stepped meanwhile. Before stepping, the thread can also make the frame-cache
+// snapshot of the state it started from (what system.store_frame() would make of it), which
+// store() later puts into the system's cache: the caller's frame is then cached without the copy. finish() waits and hands out the rotations; adopt() gives
 // the system the stepped state by exchange, and only when the system still holds the state the
 // step started from (its state revision has not moved) and its rods are the twin's. The step is
 // the system's own step on an exact copy: what adopt() gives is bit for bit what the system's
@@ -11,7 +13,9 @@
 // thread count, parallel.hpp).
 #pragma once
 
+#include <condition_variable>
 #include <cstdint>
+#include <mutex>
 #include <memory>
 #include <thread>
 #include <vector>
@@ -29,7 +33,12 @@ class RodStepAhead {
 
   // Waits for an earlier step, copies `system`'s state (its rods and colliders too when they
   // changed) and `input` (the bone matrices included), and starts the step. Returns at once.
-  void start(const RodSystem& system, const FrameInput& input);
+  // With `rotations` (bone_count x 4, the rotations the system's state was written with), the
+  // thread first makes the snapshot for store().
+  void start(const RodSystem& system, const FrameInput& input, const float* rotations = nullptr);
+  // Caches the snapshot as `frame` in `system` when it is the system the step started from and
+  // still holds that state (waits for the snapshot, not for the step). False otherwise.
+  bool store(RodSystem& system, int frame);
   // Waits for the step. True when it ran and every rod bone's rotation is finite; those rows
   // (rod bones only) are then written into rotations_out (bone_count x 4).
   bool finish(float* rotations_out);
@@ -43,6 +52,7 @@ class RodStepAhead {
 
  private:
   void wait();
+  bool same_state(const RodSystem& system) const;
 
   unsigned threads_;
   std::unique_ptr<RodSystem> twin_;
@@ -55,6 +65,13 @@ class RodStepAhead {
   std::thread worker_;
   bool stepped_ = false;  // the worker ran (joined or not)
   bool finite_ = false;
+  // The snapshot for store(): the rotations it is made with, the entry, and whether it is made.
+  std::vector<float> snapshot_rotations_;
+  FrameCache::Entry snapshot_;
+  bool snapshot_wanted_ = false;
+  bool snapshot_made_ = false;  // guarded by mutex_
+  std::mutex mutex_;
+  std::condition_variable made_;
 };
 
 }  // namespace kodawari::rod

@@ -166,6 +166,10 @@ class RodSystem {
   // `rotations` (B x 4, as written by step/reset); recall_frame() loads a frame's state
   // (when load_state is true) and writes its rod-bone rows into rotations_out (if not null).
   void store_frame(int frame, const float* rotations);
+  // What store_frame() caches, made now and cached later (by store_snapshot, in this system or
+  // its twin: RodStepAhead makes it on its own thread).
+  FrameCache::Entry snapshot(const float* rotations);
+  void store_snapshot(int frame, FrameCache::Entry entry);
   bool recall_frame(int frame, float* rotations_out, bool load_state);
   FrameCache& frame_cache() { return cache_; }
   const FrameCache& frame_cache() const { return cache_; }
