@@ -175,8 +175,10 @@ class ArmatureRuntime:
         # Evaluated matrices before and after a pass (_write_evaluated, _was_evaluated).
         self.matrices_before = np.empty((self.bone_count, 4, 4), np.float32)
         self.matrices_after = np.empty((self.bone_count, 4, 4), np.float32)
-        # (depsgraph, frame, changed bones, their matrices) after _write_evaluated, until checked.
+        # (depsgraph, frame, "view" or "rna", matrices before, changed rows) after
+        # _write_evaluated, until checked; the matrices of the view's bones, before and after.
         self.pending = None
+        self.view_matrices = None
         # The solver reads only the matrices of parents, reference bones and colliders, and
         # writes every rod bone's rotation: in a hair rig both other sets are small, so they
         # are read one by one there instead of in bulk over every bone.
@@ -272,7 +274,9 @@ class ArmatureRuntime:
             and evaluated.pose is not None
             and self._holds(evaluated.pose.bones)
         )
-        if not (held and self._was_evaluated(evaluated.pose.bones, depsgraph, self.last_frame)):
+        if not (
+            held and self._was_evaluated(obj, evaluated.pose.bones, depsgraph, self.last_frame)
+        ):
             self.pending = None
             _tag(obj)
 
@@ -298,7 +302,7 @@ class ArmatureRuntime:
             changed[view.indices] = np.any(view.read() != self.rotations[view.indices], axis=1)
             if changed.any():
                 view.write(self.rotations)
-            self._write_evaluated(obj, frame, changed)
+            self._write_evaluated(obj, frame, changed, view)
             return True
         if not self._holds(pose_bones):
             bulk.set_pose_rotations(pose_bones, self.rotations)
@@ -497,13 +501,15 @@ class ArmatureRuntime:
         if ahead is None or ahead[1] != frame or not self.ahead.store(self.system, frame):
             self.system.store_frame(frame, self.rotations)
 
-    def _write_evaluated(self, obj, frame, changed=None):
+    def _write_evaluated(self, obj, frame, changed=None, view=None):
         """Writes the rotations into the viewport's evaluated armature too: when the frame change
         re-evaluates the pose (an animated parent), it does so with them and without copying the
         whole object again. Whether it did is checked after the evaluation (_was_evaluated);
         without an evaluated copy to write, the armature is tagged (copied, evaluated once).
         `changed`: the bones whose rotation the original pose just changed (the evaluated copy
-        held what the original held), instead of reading the copy's rotations."""
+        held what the original held), instead of reading the copy's rotations. `view`: the
+        original pose's memory (bulk.PoseRotationView), whose pose matrices Blender's pass in
+        the viewport's depsgraph refreshes: read there, not through RNA, when it found them."""
         import bpy
 
         if self.pending is not None:  # an earlier write nobody evaluated: let Blender copy afresh
@@ -523,22 +529,35 @@ class ArmatureRuntime:
             changed = np.any(self.held != self.rotations, axis=1)
         elif not changed.any():
             return  # evaluate() checks after the evaluation that the copy holds them
-        before = bulk.pose_bone_matrices(pose_bones, self.matrices_before)
+        if view is not None and view.matrix_index is not None:
+            if self.view_matrices is None:
+                self.view_matrices = np.empty((2, len(view.indices), 16), np.float32)
+            before = ("view", view.read_matrices(self.view_matrices[0]), changed[view.indices])
+        else:
+            before = ("rna", bulk.pose_bone_matrices(pose_bones, self.matrices_before), changed)
         bulk.set_pose_rotations(pose_bones, self.rotations)
-        self.pending = (depsgraph.as_pointer(), frame, changed, before)
+        self.pending = (depsgraph.as_pointer(), frame, *before)
 
-    def _was_evaluated(self, pose_bones, depsgraph, frame):
+    def _was_evaluated(self, obj, pose_bones, depsgraph, frame):
         """After an evaluation that follows _write_evaluated: did Blender evaluate the pose with
         the rotations written into its copy? Every bone whose rotation changed must have a new
         matrix (a pose nothing animates is not evaluated again on a frame change). A write into
         another depsgraph's copy (the viewport's, while a render evaluates its own) is never
-        confirmed: False, so the caller's tag has Blender copy that armature afresh."""
+        confirmed: False, so the caller's tag has Blender copy that armature afresh. Matrices
+        read from the original pose's memory are the ones Blender copies back there after a
+        pass of the viewport's depsgraph, which is the one written (checked above)."""
         pending, self.pending = self.pending, None
         if pending is None:
             return True  # nothing was written into an evaluated copy
         if pending[0] != depsgraph.as_pointer() or pending[1] != frame:
             return False
-        _, _, changed, before = pending
+        _, _, source, before, changed = pending
+        if source == "view":
+            view = self.rotation_view
+            if not view or obj.pose is None or not view.current(obj.pose):
+                return False
+            after = view.read_matrices(self.view_matrices[1])
+            return bool(np.all(np.any(after[changed] != before[changed], axis=1)))
         after = bulk.pose_bone_matrices(pose_bones, self.matrices_after)
         return bool(np.all(np.any(after[changed] != before[changed], axis=(1, 2))))
 
