@@ -265,6 +265,7 @@ def measure_size(bones, chain_count, frames_ours, frames_port):
         rows[side]["frames_per_round"] = len(frames[side])
     solver["untagged_ms_median"] = split["ms_median"]
     predicted, ahead = predicted_frames(sides.player("kodawari", frames["kodawari"]))
+    phases = breakdown(sides, frames["kodawari"])
     return {
         "bones": bones,
         "rows": rows,
@@ -272,6 +273,7 @@ def measure_size(bones, chain_count, frames_ours, frames_port):
         "setup_s": round(setup, 1),
         "predicted": predicted,
         "solved_ahead": ahead,
+        "phases_ms": phases,
         "new_frames": len(frames["kodawari"]),
     }
 
@@ -304,6 +306,60 @@ def predicted_frames(play):
         predict.Prediction.mismatch = mismatch
         runtime.ArmatureRuntime._take_ahead = take
     return sum(confirmed), sum(ahead)
+
+
+# Where a new frame's time goes: the add-on's handler phases (timed around the runtime's own
+# methods), Blender's pass being the rest of the frame.
+PHASES = (
+    ("show_cached_frames", None, "pre: all"),
+    ("_take_ahead", "runtime", "pre: take the frame solved ahead (wait, exchange)"),
+    ("_step", "runtime", "pre: step in place"),
+    ("_start_ahead", "runtime", "pre: start solving the next frame"),
+    ("_write_evaluated", "runtime", "pre: write the evaluated copy"),
+    ("evaluate_scene", None, "post: all"),
+    ("_store", "runtime", "post: cache the frame"),
+    ("_write", "runtime", "post: verify the pass"),
+)
+
+
+def breakdown(sides, frames):
+    """ms per frame of each phase in one more round of the kodawari side, and Blender's pass
+    (the frame minus both handlers)."""
+    from kodawari.hair import runtime
+
+    spent = dict.fromkeys((label for _, _, label in PHASES), 0.0)
+    originals = []
+    for name, owner, label in PHASES:
+        target = runtime.ArmatureRuntime if owner else runtime
+        original = getattr(target, name)
+        originals.append((target, name, original))
+
+        def timed(*args, _original=original, _label=label, **kwargs):
+            start = time.perf_counter()
+            try:
+                return _original(*args, **kwargs)
+            finally:
+                spent[_label] += time.perf_counter() - start
+
+        setattr(target, name, timed)
+    try:
+        sides.use("kodawari")
+        sides.frame(1)  # the reset at the first frame is not a new frame's work
+        for label in spent:
+            spent[label] = 0.0
+        start = time.perf_counter()
+        for frame in frames:
+            sides.frame(frame)
+        total = time.perf_counter() - start
+        sides.use(None)
+    finally:
+        for target, name, original in originals:
+            setattr(target, name, original)
+    out = {label: round(seconds / len(frames) * 1e3, 2) for label, seconds in spent.items()}
+    out["Blender's pass (frame - handlers)"] = round(
+        (total - spent["pre: all"] - spent["post: all"]) / len(frames) * 1e3, 2
+    )
+    return out
 
 
 def untagged(play):
@@ -378,6 +434,10 @@ def main():
             f"    kodawari predicted {predicted} of {size['new_frames']} new frames, {ahead} of them solved "
             f"ahead while Blender evaluated the frame before; kodawari / kodawari_inline "
             f"{ours['ms_median'] / rows['kodawari_inline']['ms_median']:.2f}x"
+        )
+        print(
+            "    where kodawari's new frame goes (ms, one more round): "
+            + "; ".join(f"{k} {v:.2f}" for k, v in size["phases_ms"].items())
         )
         benchlib.record("hair", results)
 
