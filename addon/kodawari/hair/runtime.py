@@ -62,11 +62,11 @@ def active_camera(scene, frame):
 
 
 # The next frame is solved ahead, while Blender evaluates this one (_start_ahead), on every
-# core but one: Blender's evaluation of a pose keeps to about one core (3.4, 16,000 bones: 31 ms
-# of processor time in 43 ms), so both run side by side. Only for rigs of at least
-# AHEAD_MIN_ROD_BONES rod bones: below, Blender's evaluation (under 1 ms at 1,600 bones) is too
-# short to hide a step in, and handing the step to another thread and back costs more than it
-# saves (measured at 160 and 1,600 bones: tests/bench/bench_hair.py, docs/algorithms.md §3.7).
+# core but one: Blender's pass of a pose keeps 1.3-1.5 cores busy (16,000 bones: 31-36 ms of
+# processor time in 21-24 ms), and the step runs beside it where a core is free. Only on rigs
+# of at least AHEAD_MIN_ROD_BONES rod bones: below, Blender's pass (under 1 ms at 1,600 bones)
+# is too short to hide a step in, and handing the step to another thread and back measured no
+# faster at 160 and 1,600 bones (tests/bench/bench_hair.py, docs/algorithms.md §3.7).
 AHEAD_MIN_ROD_BONES = 4096
 
 
