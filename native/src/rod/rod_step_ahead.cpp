@@ -4,6 +4,10 @@
 #include <algorithm>
 #include <cmath>
 
+#include "kodawari/parallel.hpp"
+#include "kodawari/worker_pool.hpp"
+#include "rod_detail.hpp"
+
 namespace kodawari::rod {
 
 void RodStepAhead::wait() {
@@ -14,9 +18,19 @@ bool RodStepAhead::same_state(const RodSystem& system) const {
   return source_ == &system && system.state_revision() == state_ && system.definition_revision() == definition_;
 }
 
+void RodStepAhead::drain() {
+  const std::size_t rods = twin_->rod_count();
+  for (std::size_t c = next_chunk_.fetch_add(1); c < chunks_; c = next_chunk_.fetch_add(1)) {
+    const std::size_t begin = c * detail::kRodsPerChunk;
+    twin_->step_rods(input_, colliders_, begin, std::min(rods, begin + detail::kRodsPerChunk), rotations_.data());
+  }
+}
+
 void RodStepAhead::start(const RodSystem& system, const FrameInput& input, const float* rotations) {
   wait();
   stepped_ = finite_ = false;
+  chunks_ready_ = false;
+  begun_ = false;
   snapshot_ = FrameCache::Entry{};
   snapshot_made_ = false;
   snapshot_wanted_ = rotations != nullptr;
@@ -34,8 +48,9 @@ void RodStepAhead::start(const RodSystem& system, const FrameInput& input, const
   rotations_.assign(4 * bones, 0.0f);
   input_ = input;
   input_.bone_matrices = matrices_.data();
+  chunks_ = (twin_->rod_count() + detail::kRodsPerChunk - 1) / detail::kRodsPerChunk;
+  next_chunk_ = 0;
   worker_ = std::thread([this] {
-    bool finite = false;
     try {
       if (snapshot_wanted_) {
         FrameCache::Entry entry = twin_->snapshot(snapshot_rotations_.data());
@@ -49,13 +64,25 @@ void RodStepAhead::start(const RodSystem& system, const FrameInput& input, const
       snapshot_made_ = true;
     }
     made_.notify_all();
+    bool ready = true;
     try {
-      twin_->step(input_, rotations_.data());
-      finite = std::all_of(rotations_.begin(), rotations_.end(), [](float v) { return std::isfinite(v); });
+      colliders_ = twin_->begin_step(input_);
     } catch (...) {  // an allocation failure: no result; the caller steps the system itself
-      finite = false;
+      ready = false;
     }
-    finite_ = finite;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      chunks_ready_.store(ready, std::memory_order_release);
+      begun_ = true;
+    }
+    made_.notify_all();
+    if (!ready) {
+      stepped_ = true;
+      return;
+    }
+    // The thread and, when given more than one, the process's kept workers take the chunks.
+    const unsigned drainers = static_cast<unsigned>(std::min<std::size_t>(resolve_thread_count(threads_), chunks_));
+    parallel_chunks(std::max(1u, drainers), threads_, 1, [this](std::size_t, std::size_t) { drain(); });
     stepped_ = true;
   });
 }
@@ -76,8 +103,20 @@ bool RodStepAhead::store(RodSystem& system, int frame) {
 }
 
 bool RodStepAhead::finish(float* rotations_out) {
+  if (!worker_.joinable() && !stepped_) return false;
+  // Work on the step rather than wait for it: once the thread has begun it (after the snapshot),
+  // take the chunks nobody has taken yet.
+  if (worker_.joinable()) {
+    {
+      std::unique_lock<std::mutex> lock(mutex_);
+      made_.wait(lock, [&] { return begun_; });
+    }
+    if (chunks_ready_.load(std::memory_order_acquire)) drain();
+  }
   wait();
-  if (!stepped_ || !finite_) return false;
+  if (!stepped_ || !chunks_ready_) return false;
+  finite_ = std::all_of(rotations_.begin(), rotations_.end(), [](float v) { return std::isfinite(v); });
+  if (!finite_) return false;
   for (std::size_t r = 0; r < twin_->rod_count(); ++r) {
     for (int bone : twin_->rod(r).bones) {
       const std::size_t row = 4 * static_cast<std::size_t>(bone);

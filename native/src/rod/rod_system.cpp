@@ -158,16 +158,25 @@ void RodSystem::reset(const FrameInput& input, float* rotations_out) {
   });
 }
 
-void RodSystem::step(const FrameInput& input, float* rotations_out) {
+std::vector<Collider> RodSystem::begin_step(const FrameInput& input) {
   ++state_revision_;
-  const std::vector<Collider> colliders = world_colliders(input);
+  return world_colliders(input);
+}
+
+void RodSystem::step_rods(const FrameInput& input, const std::vector<Collider>& colliders, std::size_t begin,
+                          std::size_t end, float* rotations_out) {
+  for (std::size_t r = begin; r < end; ++r) {
+    const bool fresh = !states_[r].initialised;
+    begin_frame(r, input, colliders, fresh);
+    if (!fresh) simulate(r, input, colliders);
+    if (rotations_out) write_output(r, rotations_out);
+  }
+}
+
+void RodSystem::step(const FrameInput& input, float* rotations_out) {
+  const std::vector<Collider> colliders = begin_step(input);
   parallel_chunks(rods_.size(), threads_, kRodsPerChunk, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t r = begin; r < end; ++r) {
-      const bool fresh = !states_[r].initialised;
-      begin_frame(r, input, colliders, fresh);
-      if (!fresh) simulate(r, input, colliders);
-      if (rotations_out) write_output(r, rotations_out);
-    }
+    step_rods(input, colliders, begin, end, rotations_out);
   });
 }
 

@@ -5,7 +5,10 @@
 // the twin by the given input on its own thread; the system itself is not touched, so it can be
 // read, cached and stepped meanwhile. Before stepping, the thread can also make the frame-cache
 // snapshot of the state it started from (what system.store_frame() would make of it), which
-// store() later puts into the system's cache: the caller's frame is then cached without the copy. finish() waits and hands out the rotations; adopt() gives
+// store() later puts into the system's cache: the caller's frame is then cached without the copy.
+// The rods are taken in chunks from one counter by the thread (and, with more than one thread,
+// by the process's worker threads), and by finish() too: a caller that has to wait for the step
+// works on it instead of waiting, so a core the caller leaves idle is not wasted. finish() waits and hands out the rotations; adopt() gives
 // the system the stepped state by exchange, and only when the system still holds the state the
 // step started from (its state revision has not moved) and its rods are the twin's. The step is
 // the system's own step on an exact copy: what adopt() gives is bit for bit what the system's
@@ -13,6 +16,7 @@
 // thread count, parallel.hpp).
 #pragma once
 
+#include <atomic>
 #include <condition_variable>
 #include <cstdint>
 #include <mutex>
@@ -63,8 +67,17 @@ class RodStepAhead {
   std::vector<float> rotations_;
   FrameInput input_;
   std::thread worker_;
+  void drain();  // takes and steps chunks of rods until none are left
+
   bool stepped_ = false;  // the worker ran (joined or not)
   bool finite_ = false;
+  // The step's chunks: the colliders of the frame, the next chunk to take, and whether the
+  // chunks may be taken (set once begin_step ran; false when the thread could not start it).
+  std::vector<Collider> colliders_;
+  std::atomic<std::size_t> next_chunk_{0};
+  std::atomic<bool> chunks_ready_{false};
+  bool begun_ = false;  // the thread got past begin_step (guarded by mutex_)
+  std::size_t chunks_ = 0;
   // The snapshot for store(): the rotations it is made with, the entry, and whether it is made.
   std::vector<float> snapshot_rotations_;
   FrameCache::Entry snapshot_;

@@ -143,6 +143,12 @@ class RodSystem {
   // Advances one frame (frame_dt seconds) and writes each rod bone's rotation
   // (w, x, y, z) into rotations_out (B x 4); other rows are left untouched.
   void step(const FrameInput& input, float* rotations_out);
+  // step() in parts, for a caller that hands the rods to threads of its own (RodStepAhead):
+  // begin_step() once, then step_rods() over disjoint ranges covering [0, rod_count()), from
+  // any threads. Each rod gets the arithmetic step() gives it.
+  std::vector<Collider> begin_step(const FrameInput& input);
+  void step_rods(const FrameInput& input, const std::vector<Collider>& colliders, std::size_t begin, std::size_t end,
+                 float* rotations_out);
 
   std::size_t rod_count() const { return rods_.size(); }
   std::size_t bone_count() const { return bone_count_; }
