@@ -6,12 +6,38 @@
     render BLEND OUT addon|no-addon FRAME...
                                       render the frames (Workbench, tiny) to OUT/####.png,
                                       with the add-on enabled first, or without it
+    resave BLEND FRAME                open the file without the add-on, go to FRAME, save it
+
+The tests start it with `run_worker(...)`, which also runs in the tests' own process.
 """
 
 import os
+import subprocess
 import sys
 
 import bpy  # first: importing bpy puts Blender's own modules (addon_utils) on sys.path
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+
+
+def run_blender(*args, cwd):
+    """Runs a fresh process of the Blender the tests run in; returns (code, output)."""
+    if bpy.app.binary_path:  # the Blender program
+        command = [bpy.app.binary_path, "-b", "--factory-startup", "-noaudio", *args]
+    else:  # the bpy module: its Python, with the worker script
+        command = [sys.executable, *args]
+    done = subprocess.run(
+        command, cwd=cwd, capture_output=True, text=True, timeout=300, check=False
+    )
+    return done.returncode, done.stdout + done.stderr
+
+
+def run_worker(*args, cwd):
+    """Runs this script in a fresh Blender process with `args` (MODE ...)."""
+    script = os.path.join(HERE, "farm_worker.py")
+    if bpy.app.binary_path:
+        return run_blender("--python-exit-code", "1", "--python", script, "--", *args, cwd=cwd)
+    return run_blender(script, *args, cwd=cwd)
 
 
 def _enable_addon():
@@ -40,6 +66,13 @@ def render(blend, out, addon, frames):
         bpy.ops.render.render(write_still=True)
 
 
+def resave(blend, frame):
+    bpy.ops.wm.open_mainfile(filepath=blend)
+    assert not hasattr(bpy.types.Object, "kodawari_swim")
+    bpy.context.scene.frame_set(frame)
+    bpy.ops.wm.save_as_mainfile(filepath=blend)
+
+
 def main(argv):
     mode, blend = argv[0], argv[1]
     if mode == "bake":
@@ -50,6 +83,8 @@ def main(argv):
         import kodawari
 
         kodawari.bake_all()
+    elif mode == "resave":
+        resave(blend, int(argv[2]))
     else:
         render(blend, argv[2], argv[3], [int(f) for f in argv[4:]])
 

@@ -8,44 +8,23 @@ Each step runs in a fresh Blender process (the program or the bpy module running
 tests): bake, render with the add-on, render without it."""
 
 import os
-import subprocess
-import sys
 
 import bpy
 import numpy as np
 import pytest
 from bake_scenes import hair_rig, swimming_fish
+from farm_worker import run_blender, run_worker
 from fish_helpers import activate, make_fish
 from gait_scene import horse
 from hair_rig import add_camera
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-WORKER = os.path.join(HERE, "farm_worker.py")
 FRAMES = (1, 6, 12)
-
-
-def _blender(*args, cwd):
-    """Runs a fresh process of the Blender the tests run in; returns (code, output)."""
-    if bpy.app.binary_path:  # the Blender program
-        command = [bpy.app.binary_path, "-b", "--factory-startup", "-noaudio", *args]
-    else:  # the bpy module: its Python, with the worker script
-        command = [sys.executable, *args]
-    done = subprocess.run(
-        command, cwd=cwd, capture_output=True, text=True, timeout=300, check=False
-    )
-    return done.returncode, done.stdout + done.stderr
-
-
-def _worker(*args, cwd):
-    if bpy.app.binary_path:
-        return _blender("--python-exit-code", "1", "--python", WORKER, "--", *args, cwd=cwd)
-    return _blender(WORKER, *args, cwd=cwd)
 
 
 def _bake_all(blend, cwd):
     if bpy.app.binary_path:  # exactly the documented command
-        return _blender(blend, "--python-expr", "import kodawari; kodawari.bake_all()", cwd=cwd)
-    return _worker("bake", blend, cwd=cwd)
+        return run_blender(blend, "--python-expr", "import kodawari; kodawari.bake_all()", cwd=cwd)
+    return run_worker("bake", blend, cwd=cwd)
 
 
 def _shot(scene, path):
@@ -100,7 +79,7 @@ def test_a_baked_shot_renders_the_same_without_the_addon(empty_scene, tmp_path):
     images = {}
     for addon in ("addon", "no-addon"):
         out = tmp_path / addon
-        code, output = _worker(
+        code, output = run_worker(
             "render",
             str(farm / "shot_010.blend"),
             str(out),
