@@ -444,7 +444,10 @@ void bind_rod(py::module_& m) {
           py::arg("system"),
           "After finish(): the system takes the stepped state when it is the system the step started\n"
           "from and holds the state it started from. False, and nothing changes, otherwise.")
-      .def_property_readonly("started", &RodStepAhead::started, "A step runs or waits to be finished.");
+      .def_property_readonly("started", &RodStepAhead::started, "A step runs or waits to be finished.")
+      .def_property_readonly("caller_share", &RodStepAhead::caller_share,
+                             "The share of the rods the last finish() stepped itself (0: the thread had\n"
+                             "finished them; 1: it had not begun), in [0, 1].");
 }
 
 }  // namespace kodawari::bind

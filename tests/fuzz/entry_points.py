@@ -638,6 +638,14 @@ TARGETS = [
         examples=30,
     ),
     Target(
+        "RodStepAhead.caller_share",
+        dict,
+        _step_ahead(
+            lambda ahead, system: (ahead.finish(np.zeros((6, 4), np.float32)), ahead.caller_share)
+        ),
+        examples=1,
+    ),
+    Target(
         "RodStepAhead.started",
         dict,
         _step_ahead(lambda ahead, system: ahead.started),

@@ -68,6 +68,11 @@ def active_camera(scene, frame):
 # is too short to hide a step in, and handing the step to another thread and back measured no
 # faster at 160 and 1,600 bones (tests/bench/bench_hair.py, docs/algorithms.md §3.7).
 AHEAD_MIN_ROD_BONES = 4096
+# When the next frame's handler had to step more than this share of the rods itself, the thread
+# found no core to spare during Blender's pass (a machine busy with other work): it only slowed
+# the pass down, so the frames are solved in place for AHEAD_PAUSE_FRAMES, then tried again.
+AHEAD_MAX_CALLER_SHARE = 0.5
+AHEAD_PAUSE_FRAMES = 24
 
 
 def _ahead_threads():
@@ -204,6 +209,7 @@ class ArmatureRuntime:
         self.ahead = None
         self.ahead_matrices = None
         self.ahead_inputs = None
+        self.ahead_paused = range(0)  # frames not solved ahead (_take_ahead found no core to spare)
         self.rotation_view = None  # bulk.PoseRotationView once built, False when refused
         self.matrix_bones = (
             sorted(read) if len(read) * SPARSE_READ_RATIO <= self.bone_count else None
@@ -414,6 +420,8 @@ class ArmatureRuntime:
         self.ahead_inputs = None
         if frame > scene.frame_end or len(self.rod_bones) < AHEAD_MIN_ROD_BONES:
             return
+        if frame in self.ahead_paused:
+            return  # no core to spare lately (_take_ahead): solved in place for a while
         inputs = self._predicted_inputs(scene, frame, float(frame), ahead=True)
         if inputs is None:
             return
@@ -454,7 +462,10 @@ class ArmatureRuntime:
             or not _same_inputs(ahead_inputs, inputs)
         ):
             return False
-        return self.ahead.finish(self.rotations) and self.ahead.adopt(self.system)
+        finished = self.ahead.finish(self.rotations)
+        if self.ahead.caller_share > AHEAD_MAX_CALLER_SHARE:
+            self.ahead_paused = range(frame + 1, frame + 1 + AHEAD_PAUSE_FRAMES)
+        return finished and self.ahead.adopt(self.system)
 
     def _step(self, scene, previous, frame, armature_matrix, camera, gravity):
         """Simulates from the stored frame `previous` (recalled unless it is the state held)

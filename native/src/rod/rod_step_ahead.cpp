@@ -18,12 +18,15 @@ bool RodStepAhead::same_state(const RodSystem& system) const {
   return source_ == &system && system.state_revision() == state_ && system.definition_revision() == definition_;
 }
 
-void RodStepAhead::drain() {
+std::size_t RodStepAhead::drain() {
   const std::size_t rods = twin_->rod_count();
+  std::size_t taken = 0;
   for (std::size_t c = next_chunk_.fetch_add(1); c < chunks_; c = next_chunk_.fetch_add(1)) {
     const std::size_t begin = c * detail::kRodsPerChunk;
     twin_->step_rods(input_, colliders_, begin, std::min(rods, begin + detail::kRodsPerChunk), rotations_.data());
+    ++taken;
   }
+  return taken;
 }
 
 void RodStepAhead::start(const RodSystem& system, const FrameInput& input, const float* rotations) {
@@ -103,6 +106,7 @@ bool RodStepAhead::store(RodSystem& system, int frame) {
 }
 
 bool RodStepAhead::finish(float* rotations_out) {
+  caller_share_ = 0.0;
   if (!worker_.joinable() && !stepped_) return false;
   // Work on the step rather than wait for it: once the thread has begun it (after the snapshot),
   // take the chunks nobody has taken yet.
@@ -111,7 +115,10 @@ bool RodStepAhead::finish(float* rotations_out) {
       std::unique_lock<std::mutex> lock(mutex_);
       made_.wait(lock, [&] { return begun_; });
     }
-    if (chunks_ready_.load(std::memory_order_acquire)) drain();
+    if (chunks_ready_.load(std::memory_order_acquire)) {
+      const std::size_t taken = drain();
+      caller_share_ = chunks_ > 0 ? static_cast<double>(taken) / static_cast<double>(chunks_) : 0.0;
+    }
   }
   wait();
   if (!stepped_ || !chunks_ready_) return false;

@@ -51,6 +51,9 @@ class RodStepAhead {
   bool adopt(RodSystem& system);
   // A step is running or waits to be finished.
   bool started() const { return worker_.joinable() || stepped_; }
+  // The share of the rods the last finish() stepped itself, in [0, 1]: near 0 when the thread
+  // had a core to itself, near 1 when it hardly ran before it was needed.
+  double caller_share() const { return caller_share_; }
   // Bones of the system the last start() copied (0 before any).
   std::size_t bone_count() const { return twin_ ? twin_->bone_count() : 0; }
 
@@ -67,7 +70,8 @@ class RodStepAhead {
   std::vector<float> rotations_;
   FrameInput input_;
   std::thread worker_;
-  void drain();  // takes and steps chunks of rods until none are left
+  std::size_t drain();  // takes and steps chunks of rods until none are left; how many it took
+  double caller_share_ = 0.0;
 
   bool stepped_ = false;  // the worker ran (joined or not)
   bool finite_ = false;
