@@ -568,7 +568,7 @@ class ArmatureRuntime:
             if not view or obj.pose is None or not view.current(obj.pose):
                 return False
             after = view.read_matrices(self.view_matrices[1])
-            return bool(np.all(np.any(after[changed] != before[changed], axis=1)))
+            return bool(np.all(np.any(after != before, axis=1)[changed]))  # no row copies
         after = bulk.pose_bone_matrices(pose_bones, self.matrices_after)
         return bool(np.all(np.any(after[changed] != before[changed], axis=(1, 2))))
 
