@@ -164,3 +164,15 @@ def test_a_snapshot_of_a_state_the_system_no_longer_holds_is_not_cached():
     assert system.cached_frames() == []
     ahead.start(system, **_inputs(4))  # no rotations: no snapshot
     assert not ahead.store(system, 3)
+
+
+def test_a_step_started_again_drops_the_earlier_one_and_gives_the_new_inputs_step():
+    played, out = _started()
+    ahead_system, ahead_out = _started()
+    ahead = kn.RodStepAhead()
+    ahead.start(ahead_system, **_inputs(7))  # dropped: its frame took another path
+    ahead.start(ahead_system, **_inputs(3))
+    assert ahead.finish(ahead_out) and ahead.adopt(ahead_system)
+    played.step(rotations_out=out, **_inputs(3))
+    np.testing.assert_array_equal(ahead_out, out)
+    np.testing.assert_array_equal(ahead_system.save_state(), played.save_state())

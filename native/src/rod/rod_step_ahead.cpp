@@ -29,8 +29,13 @@ std::size_t RodStepAhead::drain() {
   return taken;
 }
 
-void RodStepAhead::start(const RodSystem& system, const FrameInput& input, const float* rotations) {
+void RodStepAhead::cancel() {
+  next_chunk_.store(chunks_);  // the chunks nobody took yet are skipped: the result is dropped
   wait();
+}
+
+void RodStepAhead::start(const RodSystem& system, const FrameInput& input, const float* rotations) {
+  cancel();  // an earlier step nobody finished (its frame took another path) is of no use now
   stepped_ = finite_ = false;
   chunks_ready_ = false;
   begun_ = false;

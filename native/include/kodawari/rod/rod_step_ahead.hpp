@@ -31,11 +31,11 @@ namespace kodawari::rod {
 class RodStepAhead {
  public:
   explicit RodStepAhead(unsigned threads = 0) : threads_(threads) {}
-  ~RodStepAhead() { wait(); }
+  ~RodStepAhead() { cancel(); }
   RodStepAhead(const RodStepAhead&) = delete;
   RodStepAhead& operator=(const RodStepAhead&) = delete;
 
-  // Waits for an earlier step, copies `system`'s state (its rods and colliders too when they
+  // Drops an earlier step (its remaining chunks skipped), copies `system`'s state (its rods and colliders too when they
   // changed) and `input` (the bone matrices included), and starts the step. Returns at once.
   // With `rotations` (bone_count x 4, the rotations the system's state was written with), the
   // thread first makes the snapshot for store().
@@ -59,6 +59,7 @@ class RodStepAhead {
 
  private:
   void wait();
+  void cancel();  // stops handing out chunks of a running step and waits for the thread
   bool same_state(const RodSystem& system) const;
 
   unsigned threads_;
