@@ -3,24 +3,23 @@
 //
 // start() copies the system's state into a twin (same rods, same colliders, no cache) and steps
 // the twin by the given input on its own thread; the system itself is not touched, so it can be
-// read, cached and stepped meanwhile. Before stepping, the thread can also make the frame-cache
-// snapshot of the state it started from (what system.store_frame() would make of it), which
-// store() later puts into the system's cache: the caller's frame is then cached without the copy.
-// The rods are taken in chunks from one counter by the thread (and, with more than one thread,
-// by the process's worker threads), and by finish() too: a caller that has to wait for the step
-// works on it instead of waiting, so a core the caller leaves idle is not wasted. finish() waits and hands out the rotations; adopt() gives
-// the system the stepped state by exchange, and only when the system still holds the state the
-// step started from (its state revision has not moved) and its rods are the twin's. The step is
-// the system's own step on an exact copy: what adopt() gives is bit for bit what the system's
-// step() with the same input would have given (the rod solver's results never depend on the
-// thread count, parallel.hpp).
+// read, cached and stepped meanwhile. Before stepping, the thread makes the frame-cache snapshot
+// of the state it started from (what system.store_frame() would make of it), which store() puts
+// into the system's cache: the caller's frame is then cached without the copy. The rods are taken
+// in chunks from one counter by the thread (with more than one thread, by the process's kept
+// workers too) and by finish(): a caller that has to wait for the step works on it instead, so
+// the core it would leave idle is not wasted. adopt() gives the system the stepped state by
+// exchange, and only while the system still holds the state the step started from (its state
+// revision has not moved) and its rods are the twin's. Each rod gets the arithmetic the
+// system's own step() gives it, so what adopt() gives is bit for bit what step() with the same
+// input would have given.
 #pragma once
 
 #include <atomic>
 #include <condition_variable>
 #include <cstdint>
-#include <mutex>
 #include <memory>
+#include <mutex>
 #include <thread>
 #include <vector>
 
@@ -35,16 +34,17 @@ class RodStepAhead {
   RodStepAhead(const RodStepAhead&) = delete;
   RodStepAhead& operator=(const RodStepAhead&) = delete;
 
-  // Drops an earlier step (its remaining chunks skipped), copies `system`'s state (its rods and colliders too when they
-  // changed) and `input` (the bone matrices included), and starts the step. Returns at once.
-  // With `rotations` (bone_count x 4, the rotations the system's state was written with), the
-  // thread first makes the snapshot for store().
+  // Drops an earlier step (the chunks nobody took are skipped), copies `system`'s state (its
+  // rods and colliders too when they changed) and `input` (the bone matrices included), and
+  // starts the step. Returns at once. With `rotations` (bone_count x 4, the rotations the
+  // system's state was written with), the thread first makes the snapshot for store().
   void start(const RodSystem& system, const FrameInput& input, const float* rotations = nullptr);
   // Caches the snapshot as `frame` in `system` when it is the system the step started from and
   // still holds that state (waits for the snapshot, not for the step). False otherwise.
   bool store(RodSystem& system, int frame);
-  // Waits for the step. True when it ran and every rod bone's rotation is finite; those rows
-  // (rod bones only) are then written into rotations_out (bone_count x 4).
+  // Steps the chunks nobody took yet, then waits for the thread. True when the step ran and
+  // every rotation is finite; the rod bones' rows are then written into rotations_out
+  // (bone_count x 4).
   bool finish(float* rotations_out);
   // After a successful finish(): exchanges the stepped state into `system` when it is the system
   // the step started from and still holds that state. False (nothing changes) otherwise.
@@ -61,6 +61,7 @@ class RodStepAhead {
   void wait();
   void cancel();  // stops handing out chunks of a running step and waits for the thread
   bool same_state(const RodSystem& system) const;
+  std::size_t drain();  // takes and steps chunks of rods until none are left; how many it took
 
   unsigned threads_;
   std::unique_ptr<RodSystem> twin_;
@@ -71,7 +72,6 @@ class RodStepAhead {
   std::vector<float> rotations_;
   FrameInput input_;
   std::thread worker_;
-  std::size_t drain();  // takes and steps chunks of rods until none are left; how many it took
   double caller_share_ = 0.0;
 
   bool stepped_ = false;  // the worker ran (joined or not)
