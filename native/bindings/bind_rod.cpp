@@ -431,8 +431,9 @@ void bind_rod(py::module_& m) {
             return self.finish(out_data);
           },
           py::arg("rotations_out"),
-          "Waits for the step; True when it ran and stayed finite: the rod bones' rows of rotations_out\n"
-          "(B, 4) float32 then hold its rotations. False: nothing was written (none started, or it diverged).")
+          "Steps the rods the thread has not taken yet (the GIL released), then waits for it; True when the\n"
+          "step ran and stayed finite: the rod bones' rows of rotations_out (B, 4) float32 then hold its\n"
+          "rotations. False: nothing was written (none started, or it diverged).")
       .def(
           "adopt",
           [](RodStepAhead& self, RodSystem& system) {
