@@ -107,7 +107,7 @@ SESSION = (
 )
 
 
-def _play_session(head_by, ahead):
+def _play_session(head_by, ahead, max_caller_share=1.0):
     """Plays SESSION on a fresh rig, solving ahead or not; returns what every frame showed and,
     per frame set, the frames that took the result solved ahead (a jump or a rebuilt runtime
     replays several)."""
@@ -129,7 +129,8 @@ def _play_session(head_by, ahead):
     runtime.ArmatureRuntime._take_ahead = spy
     min_bones, max_share = runtime.AHEAD_MIN_ROD_BONES, runtime.AHEAD_MAX_CALLER_SHARE
     runtime.AHEAD_MIN_ROD_BONES = 0  # this small rig solved ahead as a large one is
-    runtime.AHEAD_MAX_CALLER_SHARE = 1.0  # and never paused for a busy machine (timing only)
+    # Never paused for a busy machine (a timing rule), unless the test asks for it.
+    runtime.AHEAD_MAX_CALLER_SHARE = max_caller_share
     if not ahead:  # the plain path: every frame solved in its own handler
         runtime.ArmatureRuntime._start_ahead = lambda *args: None
     seen, taken_per_set = [], {}
@@ -176,3 +177,13 @@ def test_frames_solved_ahead_show_exactly_the_plain_paths_poses_whatever_happens
     # Frame 33 is predicted as before (the driver is news to the prediction), solved ahead or
     # not the same, and refuted after Blender's evaluation: solved again from Blender's inputs.
     assert not any(taken[f] for f in (34, 35, 36)), "a refuted prediction stops solving ahead"
+
+
+def test_frames_solved_in_place_while_the_step_ahead_pauses_show_the_same_poses(empty_scene):
+    """A machine with no core to spare pauses the step ahead (runtime.AHEAD_MAX_CALLER_SHARE):
+    here after every frame that took one, so the session mixes both paths."""
+    plain, _ = _play_session("action", ahead=False)
+    seen, taken = _play_session("action", ahead=True, max_caller_share=-1.0)
+    _assert_same(seen, plain)
+    assert taken[3] == [3], "the first frame after the start takes the one solved ahead"
+    assert not any(taken[f] for f in range(4, 9)), "then 24 frames are solved in place"
