@@ -239,14 +239,13 @@ class PoseRotationView:
         """rotations (B, 4) float32 for every bone; the view's bones are written."""
         self.memory[self.index] = rotations[self.indices]
 
-    def read_matrices(self, out):
-        """The view's bones' pose matrices as Blender's last evaluation in the viewport's
-        depsgraph left them, into float32 (N, 16) `out` (foreach_get's layout); None (out
-        untouched) when the matrices were not found."""
+    def read_matrices(self, rows):
+        """The pose matrices of the view's bones at `rows` (indices into `indices`) as Blender's
+        last evaluation in the viewport's depsgraph left them: float32 (len(rows), 16) in
+        foreach_get's layout; None when the matrices were not found."""
         if self.matrix_index is None:
             return None
-        np.take(self.memory, self.matrix_index, out=out.reshape(-1))
-        return out
+        return self.memory.take(self.matrix_index.reshape(-1, _POSE_MATRIX_FLOATS)[rows])
 
 
 # Shape key data without RNA. A KeyBlock keeps its positions in one float array;

@@ -111,6 +111,7 @@ class ArmatureRuntime:
         self.rod_slots = {}  # index in settings.rods -> index in the native system
         self.rod_chains = {}  # index in settings.rods -> chain bone names
         rod_bones = []
+        rod_starts = []  # where each rod's chain begins in rod_bones
         errors = []
         for i, rod in enumerate(settings.rods):
             try:
@@ -157,6 +158,7 @@ class ArmatureRuntime:
                 continue
             self.rod_slots[i] = slot
             self.rod_chains[i] = [b.name for b in chain]
+            rod_starts.append(len(rod_bones))
             rod_bones.extend(index[b.name] for b in chain)
         colliders = [c for c in settings.colliders if c.bone in index]
         errors.extend(
@@ -174,16 +176,17 @@ class ArmatureRuntime:
         self.error = "; ".join(errors)
         self.status = ""
         self.rod_bones = np.array(rod_bones, dtype=np.int64)
+        self.rod_starts = np.array(rod_starts, dtype=np.int64)
+        self.rod_view_rows = None  # rod_bones' rows in the pose view (_first_changed_rows)
         self.matrices = np.zeros((self.bone_count, 16), np.float32)
         self.rotations = np.empty((self.bone_count, 4), np.float32)
         self.held = np.empty((self.bone_count, 4), np.float32)  # rotations a pose holds now
         # Evaluated matrices before and after a pass (_write_evaluated, _was_evaluated).
         self.matrices_before = np.empty((self.bone_count, 4, 4), np.float32)
         self.matrices_after = np.empty((self.bone_count, 4, 4), np.float32)
-        # (depsgraph, frame, "view" or "rna", matrices before, changed rows) after
-        # _write_evaluated, until checked; the matrices of the view's bones, before and after.
+        # (depsgraph, frame, "view" or "rna", matrices before, the rows they are of) after
+        # _write_evaluated, until checked.
         self.pending = None
-        self.view_matrices = None
         # The solver reads only the matrices of parents, reference bones and colliders, and
         # writes every rod bone's rotation: in a hair rig both other sets are small, so they
         # are read one by one there instead of in bulk over every bone.
@@ -541,13 +544,28 @@ class ArmatureRuntime:
         elif not changed.any():
             return  # evaluate() checks after the evaluation that the copy holds them
         if view is not None and view.matrix_index is not None:
-            if self.view_matrices is None:
-                self.view_matrices = np.empty((2, len(view.indices), 16), np.float32)
-            before = ("view", view.read_matrices(self.view_matrices[0]), changed[view.indices])
+            rows = self._first_changed_rows(view, changed[view.indices])
+            before = ("view", view.read_matrices(rows), rows)
         else:
             before = ("rna", bulk.pose_bone_matrices(pose_bones, self.matrices_before), changed)
         bulk.set_pose_rotations(pose_bones, self.rotations)
         self.pending = (depsgraph.as_pointer(), frame, *before)
+
+    def _first_changed_rows(self, view, changed_rows):
+        """The view's rows (of bulk.PoseRotationView) of the first bone of each rod, in chain
+        order, whose rotation changed. Blender evaluates a bone together with every bone below
+        it (each bone's evaluation waits for its parent's), so when these got new matrices, so
+        did every changed bone: at 16,000 bones one pose matrix a rod is read, not one a bone.
+        (3.4, 4.5 and 5.0 evaluate the whole pose once an action moves any bone of it; a rig
+        nothing animates is not evaluated at all: test_hair_whole_frame.py.)"""
+        if self.rod_view_rows is None:
+            self.rod_view_rows = np.searchsorted(view.indices, self.rod_bones)
+        hits = np.flatnonzero(changed_rows[self.rod_view_rows])
+        if not len(hits):
+            return hits
+        rods = np.searchsorted(self.rod_starts, hits, side="right") - 1
+        first = np.flatnonzero(np.diff(rods, prepend=-1))
+        return self.rod_view_rows[hits[first]]
 
     def _was_evaluated(self, obj, pose_bones, depsgraph, frame):
         """After an evaluation that follows _write_evaluated: did Blender evaluate the pose with
@@ -567,8 +585,7 @@ class ArmatureRuntime:
             view = self.rotation_view
             if not view or obj.pose is None or not view.current(obj.pose):
                 return False
-            after = view.read_matrices(self.view_matrices[1])
-            return bool(np.all(np.any(after != before, axis=1)[changed]))  # no row copies
+            return bool(np.all(np.any(view.read_matrices(changed) != before, axis=1)))
         after = bulk.pose_bone_matrices(pose_bones, self.matrices_after)
         return bool(np.all(np.any(after[changed] != before[changed], axis=(1, 2))))
 
