@@ -101,6 +101,14 @@ _POSE_CHANNEL_QUAT = 9  # floats from loc[0] to quat[0]
 _POSE_VIEW_MAX_SPAN = 1 << 36  # bytes between the first and last channel a view may cover
 
 
+# After Blender evaluates a pose in the viewport's (active) depsgraph it copies every evaluated
+# bone's pose matrix back into the original channel (pose_mat, float[4][4], the layout
+# foreach_get("matrix") gives): reading it there, without RNA, tells which bones a pass
+# evaluated at ~0.01 µs a bone instead of ~0.1 through foreach_get (docs/algorithms.md §3.7).
+# Its offset is found by matching PoseBone.matrix, within the same search window.
+_POSE_MATRIX_FLOATS = 16
+
+
 def _pose_channel_floats(pose_bone):
     """The 17 floats of loc, size, eul, quat, rotAxis, rotAngle as RNA gives them."""
     angle, *axis = pose_bone.rotation_axis_angle
@@ -131,6 +139,19 @@ def _quat_offset(pose_bone):
     return None if not len(found) else int(found[0] + _POSE_CHANNEL_QUAT) * 4
 
 
+def _matrix_offsets(pose_bone):
+    """Byte offsets in this bone's bPoseChannel where its pose matrix (16 floats) lies."""
+    import ctypes
+
+    address = pose_bone.as_pointer()
+    if not address:
+        return set()
+    memory = np.frombuffer(ctypes.string_at(address, _POSE_CHANNEL_SEARCH_BYTES), np.float32)
+    want = np.array(pose_bone.matrix, np.float32).T.reshape(-1)
+    windows = np.lib.stride_tricks.sliding_window_view(memory, _POSE_MATRIX_FLOATS)
+    return {int(i) * 4 for i in np.flatnonzero(np.all(windows == want, axis=1))}
+
+
 class PoseRotationView:
     """rotation_quaternion of some original pose bones, read and written in Blender's memory
     without RNA (no update runs, nothing is tagged: the caller writes the evaluated copy too,
@@ -139,17 +160,24 @@ class PoseRotationView:
     ListBase chanbase {first, last}; a bone added, even with another removed, appends a new
     channel), and the caller compares a read with RNA's before writing."""
 
-    def __init__(self, indices, offset, addresses, pose_address, first, last, names):
+    def __init__(
+        self, indices, offset, addresses, pose_address, first, last, names, matrix_offset=None
+    ):
         import ctypes
 
         base = int(addresses.min())
-        span = int(addresses.max()) - base + offset + 16
+        end = offset + 16 if matrix_offset is None else max(offset + 16, matrix_offset + 64)
+        span = int(addresses.max()) - base + end
         self.indices = indices
         self.pose = (pose_address, first, last)
         self.names = names  # of the first and last bone, for agrees()
         memory = (ctypes.c_float * (span // 4)).from_address(base)
         self.memory = np.frombuffer(memory, np.float32)
         self.index = ((addresses - base + offset) // 4).astype(np.int64)[:, None] + np.arange(4)
+        self.matrix_index = None  # flat indices of every bone's pose matrix, when found
+        if matrix_offset is not None:
+            rows = ((addresses - base + matrix_offset) // 4).astype(np.int64)
+            self.matrix_index = (rows[:, None] + np.arange(_POSE_MATRIX_FLOATS)).reshape(-1)
 
     @staticmethod
     def _chanbase(pose):
@@ -172,6 +200,11 @@ class PoseRotationView:
         if len(offsets) != 1 or None in offsets:
             return None
         offset = offsets.pop()
+        # The pose matrix where all three agree on exactly one place past the rotation (a bone
+        # whose local and pose matrices coincide could match twice: then no matrices, RNA reads).
+        matrix = set.intersection(*(_matrix_offsets(pose_bones[i]) for i in samples))
+        matrix = {m for m in matrix if m >= offset + 16}
+        matrix_offset = matrix.pop() if len(matrix) == 1 else None
         every = np.array([pb.as_pointer() for pb in pose_bones], np.int64)
         addresses = every[indices]
         if addresses.min() <= 0 or addresses.max() - addresses.min() > _POSE_VIEW_MAX_SPAN:
@@ -180,7 +213,7 @@ class PoseRotationView:
         if chanbase[1:] != (int(every[0]), int(every[-1])):
             return None
         names = (pose_bones[int(indices[0])].name, pose_bones[int(indices[-1])].name)
-        return cls(indices, offset, addresses, *chanbase, names)
+        return cls(indices, offset, addresses, *chanbase, names, matrix_offset)
 
     def current(self, pose):
         """False once the pose or its channel list changed (a bone added or removed)."""
@@ -205,6 +238,14 @@ class PoseRotationView:
     def write(self, rotations):
         """rotations (B, 4) float32 for every bone; the view's bones are written."""
         self.memory[self.index] = rotations[self.indices]
+
+    def read_matrices(self, rows):
+        """The pose matrices of the view's bones at `rows` (indices into `indices`) as Blender's
+        last evaluation in the viewport's depsgraph left them: float32 (len(rows), 16) in
+        foreach_get's layout; None when the matrices were not found."""
+        if self.matrix_index is None:
+            return None
+        return self.memory.take(self.matrix_index.reshape(-1, _POSE_MATRIX_FLOATS)[rows])
 
 
 # Shape key data without RNA. A KeyBlock keeps its positions in one float array;

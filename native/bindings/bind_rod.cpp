@@ -9,6 +9,7 @@
 
 #include "arrays.hpp"
 #include "bind.hpp"
+#include "kodawari/rod/rod_step_ahead.hpp"
 #include "kodawari/rod/rod_system.hpp"
 #include "kodawari/rod/view_weights.hpp"
 
@@ -371,6 +372,83 @@ void bind_rod(py::module_& m) {
              std::copy(e->rotations.begin(), e->rotations.end(), out.mutable_data());
              return out;
            }, py::arg("frame"), "A cached frame's rod-bone rotations (rod bones, 4), rod by rod, root first.");
+
+  py::class_<RodStepAhead>(m, "RodStepAhead",
+                           "A RodSystem's next frame stepped on a worker thread while Python goes on (the GIL\n"
+                           "released): start() copies the system's state and the inputs and returns at once;\n"
+                           "finish() waits and writes the rod bones' rotations; adopt() gives the system the\n"
+                           "stepped state, bit for bit what its own step() would have made, only while it\n"
+                           "still holds the state the step started from (docs/algorithms.md §3.7).")
+      .def(py::init([](unsigned threads) {
+             if (threads > kMaxThreads) throw py::value_error("threads must be 0 (all cores) .. 1024");
+             return std::make_unique<RodStepAhead>(threads);
+           }), py::arg("threads") = 0)
+      .def(
+          "start",
+          [](RodStepAhead& self, const RodSystem& system, const py::handle& bone_matrices,
+             const py::handle& armature_matrix, const py::handle& camera, const py::handle& gravity, double time,
+             double frame_dt, const py::handle& rotations) {
+            py::array_t<float> keep;
+            const FrameInput in =
+                frame_input(system, bone_matrices, armature_matrix, camera, gravity, time, frame_dt, keep);
+            py::array_t<float> rows;
+            if (!rotations.is_none()) {
+              rows = checked_array<float>(rotations, "rotations", static_cast<py::ssize_t>(system.bone_count()), 4);
+            }
+            const ExclusiveUse use_system = exclusive(system);
+            const ExclusiveUse use(&self, "RodStepAhead");
+            const float* rows_data = rotations.is_none() ? nullptr : rows.data();
+            py::gil_scoped_release release;
+            self.start(system, in, rows_data);
+          },
+          py::arg("system"), py::arg("bone_matrices"), py::arg("armature_matrix"), py::arg("camera"),
+          py::arg("gravity"), py::arg("time"), py::arg("frame_dt"), py::arg("rotations") = py::none(),
+          "Starts system.step(...) with these inputs on a copy of its state; returns at once. With rotations\n"
+          "(B, 4) float32, the rotations the system's state was written with, the thread first makes the\n"
+          "frame-cache snapshot of that state for store().")
+      .def(
+          "store",
+          [](RodStepAhead& self, RodSystem& system, int frame) {
+            const ExclusiveUse use_system = exclusive(system);
+            const ExclusiveUse use(&self, "RodStepAhead");
+            py::gil_scoped_release release;
+            return self.store(system, frame);
+          },
+          py::arg("system"), py::arg("frame"),
+          "system.store_frame(frame, rotations) with the snapshot start() had made on its thread, when the\n"
+          "system still holds the state it was made of; waits for the snapshot only. False, nothing cached,\n"
+          "otherwise.")
+      .def(
+          "finish",
+          [](RodStepAhead& self, const py::handle& rotations_out) {
+            auto out = checked_output<float>(rotations_out, "rotations_out", -1, 4);
+            const ExclusiveUse use(&self, "RodStepAhead");
+            if (self.started() && static_cast<std::size_t>(out.shape(0)) != self.bone_count()) {
+              throw py::value_error("rotations_out must have one row per bone of the stepped system");
+            }
+            float* out_data = out.mutable_data();
+            py::gil_scoped_release release;
+            return self.finish(out_data);
+          },
+          py::arg("rotations_out"),
+          "Steps the rods the thread has not taken yet (the GIL released), then waits for it; True when the\n"
+          "step ran and stayed finite: the rod bones' rows of rotations_out (B, 4) float32 then hold its\n"
+          "rotations. False: nothing was written (none started, or it diverged).")
+      .def(
+          "adopt",
+          [](RodStepAhead& self, RodSystem& system) {
+            const ExclusiveUse use_system = exclusive(system);
+            const ExclusiveUse use(&self, "RodStepAhead");
+            py::gil_scoped_release release;
+            return self.adopt(system);
+          },
+          py::arg("system"),
+          "After finish(): the system takes the stepped state when it is the system the step started\n"
+          "from and holds the state it started from. False, and nothing changes, otherwise.")
+      .def_property_readonly("started", &RodStepAhead::started, "A step runs or waits to be finished.")
+      .def_property_readonly("caller_share", &RodStepAhead::caller_share,
+                             "The share of the rods the last finish() stepped itself (0: the thread had\n"
+                             "finished them; 1: it had not begun), in [0, 1].");
 }
 
 }  // namespace kodawari::bind

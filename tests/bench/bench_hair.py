@@ -8,7 +8,13 @@ then the depsgraph evaluates whatever the frame handlers tagged.
   kodawari      the add-on's live hair (every chain a rod, 4 substeps per frame), frames played
                 for the first time: the head's pose predicted from its action, the frame solved
                 and written before Blender evaluates it (frame_change_pre), Blender's evaluation,
-                the prediction checked against it (frame_change_post); one evaluation
+                the prediction checked against it (frame_change_post); one evaluation. On rigs of
+                4,096 rod bones or more the frame was solved ahead, on native threads, while
+                Blender evaluated the frame before (runtime.AHEAD_MIN_ROD_BONES); frames set back
+                to back, as here, leave that solve only Blender's evaluation to hide in (in real
+                playback it also has the viewport's drawing and the wait for the next frame)
+  kodawari_inline  the same, every frame solved in its own frame_change_pre (nothing solved ahead:
+                the path before, and of rigs below the size above)
   kodawari_post the same frames solved after Blender's evaluation instead (prediction off, the
                 path of rigs whose parents a constraint, driver or NLA moves): Blender's
                 evaluation, our handler (read, solve, write), the second evaluation our write
@@ -45,11 +51,16 @@ print = benchlib.say  # each line at once, also through a pipe
 
 BONES, SUBSTEPS = 16, 4
 BONE_LENGTH = 0.02
-# chain bones -> (chains, frames per round for kodawari and bare, frames per round for the port)
-SIZES = {160: (10, 12, 6), 1_600: (100, 8, 3), 16_000: (1000, 4, 1)}
+# chain bones -> (chains, frames per round for kodawari and bare, frames per round for the port).
+# A round's first new frame also looks at the rig afresh and has nothing solved ahead: 8 frames
+# at 16,000 bones (4 before) so that it weighs an eighth of a round, not a quarter.
+SIZES = {160: (10, 12, 6), 1_600: (100, 8, 3), 16_000: (1000, 8, 1)}
+# Rounds per side: 5, not benchlib's 3, because on a shared two-core machine the solve ahead and
+# Blender's pass share the cores with whatever else runs, and 3 medians swung by 20-40 %.
+ROUNDS = 5
 SIDES = ("kodawari", "bare", "wiggle2_port")  # each also measured for peak memory
 # timed only: their memory is kodawari's / bare's
-EXTRA_SIDES = ("kodawari_cached", "kodawari_post", "bare_retag")
+EXTRA_SIDES = ("kodawari_cached", "kodawari_inline", "kodawari_post", "bare_retag")
 
 
 def build_rig(scene, chain_count):
@@ -95,7 +106,11 @@ def _no_prediction(self, obj, scene, frame):
     return False  # every new frame solved after Blender's evaluation
 
 
-_PREDICT = []  # the add-on's own ArmatureRuntime._predict, once imported
+def _nothing_ahead(self, scene, frame, fps):
+    self.ahead_inputs = None  # every frame solved in its own frame_change_pre
+
+
+_PREDICT = []  # the add-on's own ArmatureRuntime._predict and _start_ahead, once imported
 
 
 def chain_bones(obj):
@@ -109,14 +124,24 @@ class Sides:
         from kodawari.hair import runtime
 
         if not _PREDICT:
-            _PREDICT.append(runtime.ArmatureRuntime._predict)
+            _PREDICT.extend(
+                (runtime.ArmatureRuntime._predict, runtime.ArmatureRuntime._start_ahead)
+            )
         self.scene, self.obj = scene, obj
         self.wiggle = wiggle2_port.WigglePort(scene, obj, chain_bones(obj))
 
     def use(self, side):
         from kodawari.hair import runtime
 
-        self.obj.kodawari_hair.enabled = side in ("kodawari", "kodawari_cached", "kodawari_post")
+        self.obj.kodawari_hair.enabled = side in (
+            "kodawari",
+            "kodawari_cached",
+            "kodawari_inline",
+            "kodawari_post",
+        )
+        runtime.ArmatureRuntime._start_ahead = (
+            _nothing_ahead if side == "kodawari_inline" else _PREDICT[1]
+        )
         if side == "kodawari_post":
             runtime.ArmatureRuntime._predict = _no_prediction
         elif "_predict" in vars(runtime.ArmatureRuntime) and (
@@ -230,7 +255,7 @@ def measure_size(bones, chain_count, frames_ours, frames_port):
         frames[side] = frames["kodawari"]
     players = {side: sides.player(side, frames[side]) for side in SIDES + EXTRA_SIDES}
     players["kodawari_untagged"] = untagged(sides.player("kodawari_post", frames["kodawari"]))
-    rows = benchlib.Rounds().run(players)
+    rows = benchlib.Rounds(ROUNDS).run(players)
     split = rows.pop("kodawari_untagged")
     solver = solver_alone(scene, obj, frames["kodawari"])
     for side in EXTRA_SIDES:
@@ -244,36 +269,100 @@ def measure_size(bones, chain_count, frames_ours, frames_port):
         rows[side]["bones"] = bones
         rows[side]["frames_per_round"] = len(frames[side])
     solver["untagged_ms_median"] = split["ms_median"]
-    predicted = predicted_frames(sides.player("kodawari", frames["kodawari"]))
+    predicted, ahead = predicted_frames(sides.player("kodawari", frames["kodawari"]))
+    phases = breakdown(sides, frames["kodawari"])
     return {
         "bones": bones,
         "rows": rows,
         "solver": solver,
         "setup_s": round(setup, 1),
         "predicted": predicted,
+        "solved_ahead": ahead,
+        "phases_ms": phases,
         "new_frames": len(frames["kodawari"]),
     }
 
 
 def predicted_frames(play):
     """How many of the kodawari side's new frames were solved before Blender's evaluation (their
-    predicted inputs confirmed after it), in one more untimed round."""
-    from kodawari.hair import predict
+    predicted inputs confirmed after it), and how many of those had been solved ahead while
+    Blender evaluated the frame before, in one more untimed round."""
+    from kodawari.hair import predict, runtime
 
-    confirmed = []
+    confirmed, ahead = [], []
     mismatch = predict.Prediction.mismatch
+    take = runtime.ArmatureRuntime._take_ahead
 
     def spy(self, *args):
         wrong = mismatch(self, *args)
         confirmed.append(wrong is None)
         return wrong
 
+    def spy_ahead(self, *args):
+        taken = take(self, *args)
+        ahead.append(taken)
+        return taken
+
     predict.Prediction.mismatch = spy
+    runtime.ArmatureRuntime._take_ahead = spy_ahead
     try:
         play(0)
     finally:
         predict.Prediction.mismatch = mismatch
-    return sum(confirmed)
+        runtime.ArmatureRuntime._take_ahead = take
+    return sum(confirmed), sum(ahead)
+
+
+# Where a new frame's time goes: the add-on's handler phases (timed around the runtime's own
+# methods), Blender's pass being the rest of the frame.
+PHASES = (
+    ("show_cached_frames", None, "pre: all"),
+    ("_take_ahead", "runtime", "pre: take the frame solved ahead (wait, exchange)"),
+    ("_step", "runtime", "pre: step in place"),
+    ("_start_ahead", "runtime", "pre: start solving the next frame"),
+    ("_write_evaluated", "runtime", "pre: write the evaluated copy"),
+    ("evaluate_scene", None, "post: all"),
+    ("_store", "runtime", "post: cache the frame"),
+    ("_write", "runtime", "post: verify the pass"),
+)
+
+
+def breakdown(sides, frames):
+    """ms per frame of each phase in one more round of the kodawari side, and Blender's pass
+    (the frame minus both handlers)."""
+    from kodawari.hair import runtime
+
+    spent = dict.fromkeys((label for _, _, label in PHASES), 0.0)
+    sides.use("kodawari")  # first: it sets the runtime's methods the side uses
+    sides.frame(1)  # the reset at the first frame is not a new frame's work
+    originals = []
+    for name, owner, label in PHASES:
+        target = runtime.ArmatureRuntime if owner else runtime
+        original = getattr(target, name)
+        originals.append((target, name, original))
+
+        def timed(*args, _original=original, _label=label, **kwargs):
+            start = time.perf_counter()
+            try:
+                return _original(*args, **kwargs)
+            finally:
+                spent[_label] += time.perf_counter() - start
+
+        setattr(target, name, timed)
+    try:
+        start = time.perf_counter()
+        for frame in frames:
+            sides.frame(frame)
+        total = time.perf_counter() - start
+    finally:
+        for target, name, original in originals:
+            setattr(target, name, original)
+        sides.use(None)
+    out = {label: round(seconds / len(frames) * 1e3, 2) for label, seconds in spent.items()}
+    out["Blender's pass (frame - handlers)"] = round(
+        (total - spent["pre: all"] - spent["post: all"]) / len(frames) * 1e3, 2
+    )
+    return out
 
 
 def untagged(play):
@@ -296,7 +385,7 @@ def untagged(play):
 def main():
     print(
         f"=== hair, whole frame ({benchlib.blender_label()}, {os.cpu_count()} CPUs, load {benchlib.load()}): "
-        f"ms per frame min / median of {benchlib.ROUNDS} rounds; peak RSS per side in its own process"
+        f"ms per frame min / median of {ROUNDS} rounds; peak RSS per side in its own process"
     )
     results = []
     for bones, (chain_count, frames_ours, frames_port) in benchlib.sizes(SIZES).items():
@@ -307,7 +396,13 @@ def main():
         print(f"  {bones:>6,} chain bones ({chain_count} chains, set-up {size['setup_s']} s):")
         for side in SIDES + EXTRA_SIDES:
             row = rows[side]
-            if side in ("kodawari", "kodawari_cached", "kodawari_post", "bare_retag"):
+            if side in (
+                "kodawari",
+                "kodawari_cached",
+                "kodawari_inline",
+                "kodawari_post",
+                "bare_retag",
+            ):
                 ratio = f"  this / bare {row['ms_median'] / bare['ms_median']:5.2f}x"
             elif side == "bare":
                 ratio = ""
@@ -337,7 +432,16 @@ def main():
             f"{floor - bare['ms_median']:.2f} ms = {(floor - bare['ms_median']) / bare['ms_median']:.2f}x the "
             f"bare evaluation; kodawari / bare_retag {ours['ms_median'] / floor:.2f}x"
         )
-        print(f"    kodawari predicted {size['predicted']} of {size['new_frames']} new frames")
+        predicted, ahead = size["predicted"], size["solved_ahead"]
+        print(
+            f"    kodawari predicted {predicted} of {size['new_frames']} new frames, {ahead} of them solved "
+            f"ahead while Blender evaluated the frame before; kodawari / kodawari_inline "
+            f"{ours['ms_median'] / rows['kodawari_inline']['ms_median']:.2f}x"
+        )
+        print(
+            "    where kodawari's new frame goes (ms, one more round): "
+            + "; ".join(f"{k} {v:.2f}" for k, v in size["phases_ms"].items())
+        )
         benchlib.record("hair", results)
 
 

@@ -201,15 +201,15 @@ def test_a_duplicate_swims_with_its_own_settings(empty_scene):
 
 
 def test_the_live_mesh_carries_one_small_attribute_and_no_shape_key(empty_scene):
-    # Memory (issue 13 item 4): per vertex the swim adds 12 bytes to the user's mesh (the
-    # packed (s, u, v)); no shape key (a Basis and a swim key: 24 bytes more per vertex).
+    # Memory (issue 13 item 4): per vertex the swim adds 12 bytes to the user's mesh ((s, u,
+    # v), three floats); no shape key (a Basis and a swim key: 24 bytes more per vertex).
     set_fps(24)
     obj = make_fish("tuna")
     names = {a.name for a in obj.data.attributes}
     add_swim(obj, head_axis="POS_X", frequency=2.0)
     bpy.context.scene.frame_set(3)
     added = [(a.name, a.data_type, a.domain) for a in obj.data.attributes if a.name not in names]
-    assert added == [(".kodawari_swim_ffd", "FLOAT_VECTOR", "POINT")]
+    assert sorted(added) == [(f".kodawari_swim_{c}", "FLOAT", "POINT") for c in "suv"]
     assert obj.data.shape_keys is None
     # ... and hands none on: what renders, exports and later modifiers see has no copy.
     shown = obj.evaluated_get(bpy.context.evaluated_depsgraph_get()).data
@@ -233,4 +233,30 @@ def test_a_file_saved_with_the_old_swim_shape_key_plays_through_the_modifier(emp
     worst, moved = _route_equals_core(obj, (3, 5))
     assert moved > 0.02 and worst < 1e-5
     assert obj.data.shape_keys is None and obj.modifiers[0].name == MODIFIER
+    assert np.array_equal(rest(obj), original)
+
+
+def test_a_file_saved_with_the_packed_float3_binding_swims_again(empty_scene):
+    # The route first kept (s, u, v) in one float3 attribute, read through Separate XYZ.
+    # Such a file swims on its next frame, bound again to the three float attributes, the
+    # float3 gone (no 12 bytes per vertex left behind).
+    set_fps(24)
+    obj = make_fish("tuna")
+    original = rest(obj).copy()
+    settings = add_swim(obj, fins=("fin_caudal",), head_axis="POS_X", frequency=2.0)
+    from kodawari.fish import route, runtime
+
+    rig = runtime.get_rig(obj)
+    packed = rig.packed_coordinates().copy()
+    mesh = obj.data
+    for name in route.COORDINATES:  # what that version left in the file:
+        mesh.attributes.remove(mesh.attributes[name])
+    old = mesh.attributes.new(route.PACKED, "FLOAT_VECTOR", "POINT")
+    old.data.foreach_set("vector", packed.reshape(-1))
+    runtime.forget(obj)  # a file opened: the rigs are rebuilt
+    assert settings.enabled and runtime.has_swim(obj)
+    worst, moved = _route_equals_core(obj, (3, 5))
+    assert moved > 0.02 and worst < 1e-5
+    assert mesh.attributes.find(route.PACKED) < 0
+    assert all(mesh.attributes.find(name) >= 0 for name in route.COORDINATES)
     assert np.array_equal(rest(obj), original)

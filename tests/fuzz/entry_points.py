@@ -165,6 +165,38 @@ def _cached_rod_method(name):
     return _method(make_self, name, _rod_state)
 
 
+def _ahead_args(with_rotations=True):
+    """RodStepAhead.start's arguments: a fresh chain system and a frame's inputs."""
+    args = _frame_args()
+    out = args.pop("rotations_out")
+    args["system"] = _chain_system()
+    if with_rotations:
+        args["rotations"] = out
+    return args
+
+
+def _step_ahead(call):
+    """Starts a step ahead, then calls call(ahead, system, **kwargs): (result, the system's
+    state), so what finish/adopt/store leave behind is checked too."""
+
+    def run(**kwargs):
+        system = _chain_system()
+        ahead = kn.RodStepAhead(threads=1)
+        start = _frame_args()
+        out = start.pop("rotations_out")
+        ahead.start(system=system, rotations=out, **start)
+        return call(ahead, system, **kwargs), _rod_state(system)
+
+    return run
+
+
+def _ahead_start(system, **kwargs):
+    ahead = kn.RodStepAhead(threads=1)
+    ahead.start(system=system, **kwargs)
+    out = np.zeros((6, 4), np.float32)
+    return ahead.finish(out), out, ahead.adopt(system), _rod_state(system)
+
+
 def _set_cache_budget(budget):
     """Sets the budget, then fills the cache past it: the thinning must keep a usable cache."""
     system = _chain_system()
@@ -571,6 +603,52 @@ TARGETS = [
         "RodSystem.cache_checkpoint_interval",
         dict,
         lambda: _chain_system().cache_checkpoint_interval,
+        examples=1,
+    ),
+    # --- the next frame stepped ahead (RodStepAhead)
+    Target("RodStepAhead", lambda: {"threads": 1}, kn.RodStepAhead, examples=20),
+    Target(
+        "RodStepAhead.start",
+        _ahead_args,
+        _ahead_start,
+        alias=(("rotations", "bone_matrices"),),
+        examples=80,
+        extra_names=("system",),
+    ),
+    Target(
+        "RodStepAhead.finish",
+        lambda: {"rotations_out": np.zeros((6, 4), np.float32)},
+        _step_ahead(lambda ahead, system, **kw: ahead.finish(**kw)),
+        outputs=("rotations_out",),
+    ),
+    Target(
+        "RodStepAhead.adopt",
+        dict,
+        _step_ahead(
+            lambda ahead, system: (ahead.finish(np.zeros((6, 4), np.float32)), ahead.adopt(system))
+        ),
+        examples=5,
+    ),
+    Target(
+        "RodStepAhead.store",
+        lambda: {"frame": 3},
+        _step_ahead(
+            lambda ahead, system, **kw: (ahead.store(system, **kw), system.cached_frames())
+        ),
+        examples=30,
+    ),
+    Target(
+        "RodStepAhead.caller_share",
+        dict,
+        _step_ahead(
+            lambda ahead, system: (ahead.finish(np.zeros((6, 4), np.float32)), ahead.caller_share)
+        ),
+        examples=1,
+    ),
+    Target(
+        "RodStepAhead.started",
+        dict,
+        _step_ahead(lambda ahead, system: ahead.started),
         examples=1,
     ),
     # --- gait

@@ -74,3 +74,36 @@ def test_threads_sharing_a_rod_system_are_refused_not_crashed():
     assert run_threads(work) == []
     positions = system.joint_positions(0)
     assert np.isfinite(positions).all()
+
+
+def test_threads_sharing_a_step_ahead_and_its_system_are_refused_not_crashed():
+    """Python threads racing start/finish/adopt/store on one RodStepAhead while others step
+    the system: each call runs whole or is refused; the system stays usable."""
+    system = _chain_system(bones=40, bone_count=42)
+    ahead = kn.RodStepAhead(threads=1)
+    args = _frame_args(bone_count=42)
+    out_args = args.pop("rotations_out")
+    stop = time.monotonic() + 1.5
+
+    def work(k):
+        out = out_args.copy()
+        frame = 0
+        while time.monotonic() < stop:
+            frame += 1
+            try:
+                if k == 0:
+                    ahead.start(system, rotations=out, **args)
+                elif k == 1:
+                    if ahead.finish(out):
+                        ahead.adopt(system)
+                elif k == 2:
+                    ahead.store(system, frame % 40)
+                else:
+                    system.step(rotations_out=out, **args)
+            except RuntimeError as exc:
+                assert "in use by another thread" in str(exc)
+
+    assert run_threads(work) == []
+    out = out_args.copy()
+    system.step(rotations_out=out, **args)
+    assert np.isfinite(system.joint_positions(0)).all()

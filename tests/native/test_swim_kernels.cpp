@@ -2,6 +2,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <thread>
+#include <vector>
 
 #include "kodawari/ffd/bspline.hpp"
 #include "kodawari/swim/body_wave.hpp"
@@ -100,6 +102,41 @@ TEST(BodyWave, SameInputsGiveBitIdenticalOutputs) {
   const Vec3List a = body_axis(rest, Vec3(0, 1, 0), 1.3, carangiform(), 12.345);
   const Vec3List b = body_axis(rest, Vec3(0, 1, 0), 1.3, carangiform(), 12.345);
   for (std::size_t i = 0; i < a.size(); ++i) EXPECT_EQ(a[i], b[i]);
+}
+
+// A live fish asks every frame with the same rest axis and settings, and the wave's
+// phase-free part is kept between calls: a call after others (other settings, another rest
+// axis, more than the kept few) is bit for bit a first call on a thread of its own.
+TEST(BodyWave, AxisAfterOtherCallsIsTheAxisComputedAfresh) {
+  const Vec3List rest = straight_axis(8, 1.3);
+  Vec3List bent = rest;
+  bent[3].y() += 0.02;
+  auto axis = [](const Vec3List& points, Real amplitude, Real phase) {
+    BodyWave wave = carangiform();
+    wave.amplitude = amplitude;
+    return body_axis(points, Vec3(0, 1, 0), 1.3, wave, phase);
+  };
+  auto afresh = [&](const Vec3List& points, Real amplitude, Real phase) {
+    Vec3List out;
+    std::thread([&] { out = axis(points, amplitude, phase); }).join();
+    return out;
+  };
+  std::vector<Vec3List> seen;
+  for (int round = 0; round < 2; ++round) {
+    for (int k = 0; k < 10; ++k) {  // more settings than are kept
+      seen.push_back(axis(k % 2 ? bent : rest, 0.05 + 0.01 * k, 0.3 * k));
+    }
+  }
+  for (int k = 0; k < 10; ++k) {
+    const Vec3List expected = afresh(k % 2 ? bent : rest, 0.05 + 0.01 * k, 0.3 * k);
+    for (int round = 0; round < 2; ++round) {
+      const Vec3List& got = seen[static_cast<std::size_t>(10 * round + k)];
+      for (std::size_t i = 0; i < got.size(); ++i) EXPECT_EQ(got[i], expected[i]) << k << " " << round;
+    }
+  }
+  // Different settings, different axis: nothing is served for the wrong inputs.
+  EXPECT_NE(axis(rest, 0.05, 0.9)[7], axis(rest, 0.08, 0.9)[7]);
+  EXPECT_NE(axis(rest, 0.05, 0.9)[7], axis(bent, 0.05, 0.9)[7]);
 }
 
 TEST(AccumulatePhase, ConstantFrequencyGivesTwoPiFT) {

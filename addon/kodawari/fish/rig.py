@@ -177,7 +177,10 @@ class SwimRig:
         if not self.binding.released:
             return self.binding.packed_coordinates(self.end_scale)
         out = np.empty((self.count, 3), dtype=np.float32)
-        self.owner.data.attributes[route.COORDINATES].data.foreach_get("vector", out.reshape(-1))
+        column = np.empty(self.count, dtype=np.float32)
+        for k, name in enumerate(route.COORDINATES):
+            self.owner.data.attributes[name].data.foreach_get("value", column)
+            out[:, k] = column
         return out
 
     def release_coordinates(self):

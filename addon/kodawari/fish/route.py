@@ -1,8 +1,8 @@
 """Fish Swim as a Geometry Nodes modifier (docs/algorithms.md §1.6).
 
 The live swim bends the fish inside Blender's own evaluation: a "Fish Swim" Geometry
-Nodes modifier, first in the stack, reads each vertex's bound FFD coordinates (one
-3-float attribute, bound once) and the current frame table (1024 segments x 8 vectors
+Nodes modifier, first in the stack, reads each vertex's bound FFD coordinates (three
+float attributes, bound once) and the current frame table (1024 segments x 8 vectors
 and the tail's frame, written per frame into a small helper mesh) and sets the bent
 positions with Sample Index nodes. Moving fins add a per-vertex offset the core computes per frame for the
 fin vertices only, written into a second helper mesh and read by an index attribute.
@@ -21,7 +21,10 @@ MODIFIER = "Fish Swim"
 GROUP = ".Kodawari Fish Swim"
 TABLE = ".Kodawari Fish Swim Frames"
 FINS = ".Kodawari Fish Swim Fins"
-COORDINATES = ".kodawari_swim_ffd"  # float3 per vertex: (s, u, v), docs/algorithms.md §1.6
+# Per vertex (s, u, v) as three float attributes (docs/algorithms.md §1.6): each read is a
+# field over the attribute's own array, where one float3 needed a Separate XYZ per frame.
+COORDINATES = (".kodawari_swim_s", ".kodawari_swim_u", ".kodawari_swim_v")
+PACKED = ".kodawari_swim_ffd"  # the same as one float3: files saved before, bound again
 FIN_INDEX = ".kodawari_swim_fin"  # int per vertex: its row in the fin helper, -1 off the fins
 FIN_OFFSET = "offset"
 SEGMENTS = 1024
@@ -130,9 +133,7 @@ def build_group(table_obj, fins_obj, end_scale, with_keys=False, with_ends=True)
     tree = _Tree(group)
     group_in, group_out = tree.node("NodeGroupInput"), tree.node("NodeGroupOutput")
     table = tree.object_geometry("frames", table_obj)
-    split = tree.node("ShaderNodeSeparateXYZ")
-    tree.links.new(tree.named(COORDINATES, "FLOAT_VECTOR"), split.inputs[0])
-    s, u, v = split.outputs["X"], split.outputs["Y"], split.outputs["Z"]
+    s, u, v = (tree.named(name, "FLOAT") for name in COORDINATES)
     t, w = s, None
     if with_ends:
         clamp = tree.node("ShaderNodeClamp")
@@ -186,7 +187,7 @@ def build_group(table_obj, fins_obj, end_scale, with_keys=False, with_ends=True)
     # The bound attributes stay on the user's mesh, not on what the swim hands on: Blender
     # 3.4 copies the mesh for Set Position (the attribute too, 12 bytes per vertex more
     # until the next frame), and exports and later modifiers have no use for them.
-    for name in (COORDINATES, FIN_INDEX) if fins_obj is not None else (COORDINATES,):
+    for name in (*COORDINATES, FIN_INDEX) if fins_obj is not None else COORDINATES:
         remove = tree.node("GeometryNodeRemoveAttribute")
         remove.inputs["Name"].default_value = name
         tree.links.new(result, remove.inputs["Geometry"])
@@ -270,8 +271,11 @@ def install(obj, rig):
         mod = obj.modifiers.new(MODIFIER, "NODES")
     packed = rig.packed_coordinates()
     with_ends = has_ends(packed)
-    _write_attribute(mesh, COORDINATES, "FLOAT_VECTOR", packed)
+    for k, name in enumerate(COORDINATES):
+        _write_attribute(mesh, name, "FLOAT", np.ascontiguousarray(packed[:, k]))
     del packed
+    if mesh.attributes.get(PACKED) is not None:
+        mesh.attributes.remove(mesh.attributes[PACKED])
     with_keys = mesh.shape_keys is not None
     rest_fields = tuple(REST + f for f in FIELDS) if with_keys else ()
     table_obj = _helper_object(TABLE, ROWS, FIELDS + rest_fields)
@@ -301,15 +305,25 @@ def install(obj, rig):
     return mod
 
 
+def has_attribute(mesh, name):
+    """The mesh has an attribute of that name, asked without touching its values. Blender
+    4+ shares a mesh's arrays with its evaluated copy; `attributes.get(name)` and `name in
+    attributes` hand out a writable attribute, so Blender first gives the user's mesh a copy
+    of its own (12 bytes per vertex for the bound coordinates, kept while the evaluated copy
+    lives: every frame of playback). `find` only compares names."""
+    return mesh.attributes.find(name) >= 0
+
+
 def installed_for(obj, rig):
-    """True when the object's route was installed for this very rig (same binding)."""
+    """True when the object's route was installed for this very rig (same binding). Asked
+    every frame: it reads nothing per vertex and copies nothing (has_attribute)."""
     mod = modifier(obj)
     if mod is None or getattr(rig, "installed_on", None) != obj.data.as_pointer():
         return False
     mesh = obj.data
     return (
-        mesh.attributes.get(COORDINATES) is not None
-        and (rig.fin_vertices is None) == (mesh.attributes.get(FIN_INDEX) is None)
+        all(has_attribute(mesh, name) for name in COORDINATES)
+        and (rig.fin_vertices is None) != has_attribute(mesh, FIN_INDEX)
         # shape keys added or removed since: the tree reads their offset, or not
         and bool(mod.node_group.get("kodawari_with_keys")) == (mesh.shape_keys is not None)
     )
@@ -324,7 +338,7 @@ def uninstall(obj):
         obj.modifiers.remove(mod)
     mesh = obj.data
     if mesh is not None and getattr(mesh, "library", None) is None:
-        for name in (COORDINATES, FIN_INDEX):
+        for name in (*COORDINATES, PACKED, FIN_INDEX):
             attribute = mesh.attributes.get(name)
             if attribute is not None:
                 mesh.attributes.remove(attribute)

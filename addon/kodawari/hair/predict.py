@@ -187,7 +187,7 @@ class PosePredictor:
         ):
             raise Unpredictable("the armature data is animated")
         self.motion = ObjectMotion(obj, "the armature")
-        names = [pb.name for pb in pose_bones]
+        names = pose_bones.keys()  # one call into Blender, not one per bone
         index = {name: i for i, name in enumerate(names)}
         # The input bones and their ancestors, parents first.
         needed = set()

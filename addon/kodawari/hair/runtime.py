@@ -61,6 +61,26 @@ def active_camera(scene, frame):
     return min(markers, key=lambda m: m.frame).camera
 
 
+# The next frame is solved ahead, while Blender evaluates this one (_start_ahead), on every
+# core but one: Blender's pass of a pose keeps 1.3-1.5 cores busy (16,000 bones: 31-36 ms of
+# processor time in 21-24 ms), and the step runs beside it where a core is free. Only on rigs
+# of at least AHEAD_MIN_ROD_BONES rod bones: below, Blender's pass (under 1 ms at 1,600 bones)
+# is too short to hide a step in, and handing the step to another thread and back measured no
+# faster at 160 and 1,600 bones (tests/bench/bench_hair.py, docs/algorithms.md §3.7).
+AHEAD_MIN_ROD_BONES = 4096
+# When the next frame's handler had to step more than this share of the rods itself, the thread
+# found no core to spare during Blender's pass (a machine busy with other work): it only slowed
+# the pass down, so the frames are solved in place for AHEAD_PAUSE_FRAMES, then tried again.
+AHEAD_MAX_CALLER_SHARE = 0.5
+AHEAD_PAUSE_FRAMES = 24
+
+
+def _ahead_threads():
+    import os
+
+    return max(1, (os.cpu_count() or 2) - 1)
+
+
 # Reading a few bones one by one beats a foreach_get over all of them when they are
 # fewer than 1 in this many (~5 us per bone against ~0.03 us per bone in bulk).
 SPARSE_READ_RATIO = 256
@@ -91,6 +111,7 @@ class ArmatureRuntime:
         self.rod_slots = {}  # index in settings.rods -> index in the native system
         self.rod_chains = {}  # index in settings.rods -> chain bone names
         rod_bones = []
+        rod_starts = []  # where each rod's chain begins in rod_bones
         errors = []
         for i, rod in enumerate(settings.rods):
             try:
@@ -137,6 +158,7 @@ class ArmatureRuntime:
                 continue
             self.rod_slots[i] = slot
             self.rod_chains[i] = [b.name for b in chain]
+            rod_starts.append(len(rod_bones))
             rod_bones.extend(index[b.name] for b in chain)
         colliders = [c for c in settings.colliders if c.bone in index]
         errors.extend(
@@ -154,13 +176,16 @@ class ArmatureRuntime:
         self.error = "; ".join(errors)
         self.status = ""
         self.rod_bones = np.array(rod_bones, dtype=np.int64)
+        self.rod_starts = np.array(rod_starts, dtype=np.int64)
+        self.rod_view_rows = None  # rod_bones' rows in the pose view (_first_changed_rows)
         self.matrices = np.zeros((self.bone_count, 16), np.float32)
         self.rotations = np.empty((self.bone_count, 4), np.float32)
         self.held = np.empty((self.bone_count, 4), np.float32)  # rotations a pose holds now
         # Evaluated matrices before and after a pass (_write_evaluated, _was_evaluated).
         self.matrices_before = np.empty((self.bone_count, 4, 4), np.float32)
         self.matrices_after = np.empty((self.bone_count, 4, 4), np.float32)
-        # (depsgraph, frame, changed bones, their matrices) after _write_evaluated, until checked.
+        # (depsgraph, frame, "view" or "rna", matrices before, the rows they are of) after
+        # _write_evaluated, until checked.
         self.pending = None
         # The solver reads only the matrices of parents, reference bones and colliders, and
         # writes every rod bone's rotation: in a hair rig both other sets are small, so they
@@ -182,6 +207,12 @@ class ArmatureRuntime:
         self.predictor = None  # built at the first new frame (predict.PosePredictor)
         self.prediction_off = None  # why this rig's frames are not predicted, once known
         self.predicted = None  # the prediction made before the pass, until checked after it
+        # The next frame solved ahead on native threads (_start_ahead): native.RodStepAhead,
+        # its bone matrices, and what it was started from, until _take_ahead looks at it.
+        self.ahead = None
+        self.ahead_matrices = None
+        self.ahead_inputs = None
+        self.ahead_paused = range(0)  # frames not solved ahead (_take_ahead found no core to spare)
         self.rotation_view = None  # bulk.PoseRotationView once built, False when refused
         self.matrix_bones = (
             sorted(read) if len(read) * SPARSE_READ_RATIO <= self.bone_count else None
@@ -252,7 +283,9 @@ class ArmatureRuntime:
             and evaluated.pose is not None
             and self._holds(evaluated.pose.bones)
         )
-        if not (held and self._was_evaluated(evaluated.pose.bones, depsgraph, self.last_frame)):
+        if not (
+            held and self._was_evaluated(obj, evaluated.pose.bones, depsgraph, self.last_frame)
+        ):
             self.pending = None
             _tag(obj)
 
@@ -278,7 +311,7 @@ class ArmatureRuntime:
             changed[view.indices] = np.any(view.read() != self.rotations[view.indices], axis=1)
             if changed.any():
                 view.write(self.rotations)
-            self._write_evaluated(obj, frame, changed)
+            self._write_evaluated(obj, frame, changed, view)
             return True
         if not self._holds(pose_bones):
             bulk.set_pose_rotations(pose_bones, self.rotations)
@@ -325,7 +358,9 @@ class ArmatureRuntime:
     def _predict(self, obj, scene, frame):
         """Solves the frame after the last simulated one from inputs predicted before Blender
         evaluates it (predict.py); evaluate() checks them against Blender's after the pass.
-        False (nothing changed) when this rig's or this frame's inputs cannot be predicted."""
+        False (nothing changed) when this rig's or this frame's inputs cannot be predicted.
+        The next frame is then solved ahead, on native threads, while Blender evaluates this
+        one (_start_ahead); the next call takes that result when it is what it would solve."""
         if self.predicted is not None:
             return False  # an earlier prediction was never checked: evaluate() sorts it out
         previous = self._previous_frame(frame)
@@ -337,23 +372,14 @@ class ArmatureRuntime:
             except predict.Unpredictable as exc:
                 self.prediction_off = str(exc)
                 return False
-        time = scene.frame_current_final
-        camera = active_camera(scene, frame)
-        camera_position = None
-        if camera is not None and self.view_keys:
-            camera_position = self.predictor.camera_position(camera, time)
-            if camera_position is None:
-                return False  # a camera moved by more than its own action: this frame only
-        elif camera is not None:  # no view keys: the camera's position changes nothing
-            camera_position = np.array(camera.matrix_world.translation, np.float64)
-        try:
-            matrices, armature_matrix = self.predictor.predict(time)
-        except (predict.Unpredictable, ValueError) as exc:
-            self.prediction_off = str(exc)
+        inputs = self._predicted_inputs(scene, frame, scene.frame_current_final)
+        if inputs is None:
             return False
-        gravity = _gravity(scene)
+        matrices, armature_matrix, camera_position, gravity = inputs
         self.matrices[self.input_bones] = matrices
-        self._step(scene, previous, frame, armature_matrix, camera_position, gravity)
+        fps = _fps(scene)
+        if not self._take_ahead(frame, previous, inputs, fps):
+            self._step(scene, previous, frame, armature_matrix, camera_position, gravity)
         self.predicted = predict.Prediction(
             frame,
             previous,
@@ -364,8 +390,85 @@ class ArmatureRuntime:
             self.rotations,
             self.view_keys,
         )
-        self.status = "" if camera is not None else NO_CAMERA
+        self.status = "" if active_camera(scene, frame) is not None else NO_CAMERA
+        self._start_ahead(scene, frame + 1, fps)
         return True
+
+    def _predicted_inputs(self, scene, frame, time, ahead=False):
+        """(input bone matrices, armature matrix, camera position, gravity) predicted for
+        `frame` at scene time `time`, or None when this frame's camera cannot be predicted or
+        the rig turns out unpredictable (then prediction_off says why, unless only looking
+        `ahead`: the frame itself will find out if it is ever played)."""
+        camera = active_camera(scene, frame)
+        camera_position = None
+        if camera is not None and self.view_keys:
+            camera_position = self.predictor.camera_position(camera, time)
+            if camera_position is None:
+                return None  # a camera moved by more than its own action: this frame only
+        elif camera is not None:  # no view keys: the camera's position changes nothing
+            camera_position = np.array(camera.matrix_world.translation, np.float64)
+        try:
+            matrices, armature_matrix = self.predictor.predict(time)
+        except (predict.Unpredictable, ValueError) as exc:
+            if not ahead:
+                self.prediction_off = str(exc)
+            return None
+        return matrices, armature_matrix, camera_position, _gravity(scene)
+
+    def _start_ahead(self, scene, frame, fps):
+        """Starts solving `frame` (the one after the frame just solved) on native threads from
+        its predicted inputs, while Blender evaluates the frame just written (docs/algorithms.md
+        §3.7). Nothing of it is used unless _take_ahead finds it is exactly what `frame` would
+        solve. Skipped past the scene's end (playback wraps to the start, which resets)."""
+        self.ahead_inputs = None
+        if frame > scene.frame_end or len(self.rod_bones) < AHEAD_MIN_ROD_BONES:
+            return
+        if frame in self.ahead_paused:
+            return  # no core to spare lately (_take_ahead): solved in place for a while
+        inputs = self._predicted_inputs(scene, frame, float(frame), ahead=True)
+        if inputs is None:
+            return
+        matrices, armature_matrix, camera_position, gravity = inputs
+        if self.ahead is None:
+            self.ahead = native.module().RodStepAhead(_ahead_threads())
+            self.ahead_matrices = self.matrices.copy()
+        self.ahead_matrices[self.input_bones] = matrices  # the rods read these rows only
+        try:
+            self.ahead.start(
+                self.system,
+                self.ahead_matrices,
+                armature_matrix,
+                camera_position,
+                gravity,
+                frame / fps,
+                1 / fps,
+                self.rotations,  # the frame just solved: cached from the thread's snapshot (_store)
+            )
+        except ValueError:
+            return  # inputs the solver refuses: the frame itself says so if it is ever played
+        self.ahead_inputs = (frame, frame - 1, inputs, fps)  # stepped from the frame just solved
+
+    def _take_ahead(self, frame, previous, inputs, fps):
+        """True when the frame solved ahead (_start_ahead) is `frame`, stepped from the state this
+        system holds (`previous`, unchanged since: the native side checks its state revision)
+        with exactly these inputs: its rotations are then in self.rotations and its state is the
+        system's, bit for bit what _step would have made. False otherwise (it is dropped)."""
+        ahead, self.ahead_inputs = self.ahead_inputs, None
+        if ahead is None:
+            return False
+        ahead_frame, ahead_previous, ahead_inputs, ahead_fps = ahead
+        if (
+            ahead_frame != frame
+            or ahead_previous != previous
+            or self.last_frame != previous
+            or ahead_fps != fps
+            or not _same_inputs(ahead_inputs, inputs)
+        ):
+            return False
+        finished = self.ahead.finish(self.rotations)
+        if self.ahead.caller_share > AHEAD_MAX_CALLER_SHARE:
+            self.ahead_paused = range(frame + 1, frame + 1 + AHEAD_PAUSE_FRAMES)
+        return finished and self.ahead.adopt(self.system)
 
     def _step(self, scene, previous, frame, armature_matrix, camera, gravity):
         """Simulates from the stored frame `previous` (recalled unless it is the state held)
@@ -401,17 +504,26 @@ class ArmatureRuntime:
         if wrong is not None:
             self.prediction_off = wrong
             self._step(scene, prediction.previous, frame, armature_matrix, camera, gravity)
-        self.system.store_frame(frame, self.rotations)
+        self._store(frame)
         self._write(obj, depsgraph)
         return True
 
-    def _write_evaluated(self, obj, frame, changed=None):
+    def _store(self, frame):
+        """Caches `frame`, the state the system holds: with the snapshot the step ahead made of
+        this very state on its own thread (off this frame's path) when there is one, else now."""
+        ahead = self.ahead_inputs
+        if ahead is None or ahead[1] != frame or not self.ahead.store(self.system, frame):
+            self.system.store_frame(frame, self.rotations)
+
+    def _write_evaluated(self, obj, frame, changed=None, view=None):
         """Writes the rotations into the viewport's evaluated armature too: when the frame change
         re-evaluates the pose (an animated parent), it does so with them and without copying the
         whole object again. Whether it did is checked after the evaluation (_was_evaluated);
         without an evaluated copy to write, the armature is tagged (copied, evaluated once).
         `changed`: the bones whose rotation the original pose just changed (the evaluated copy
-        held what the original held), instead of reading the copy's rotations."""
+        held what the original held), instead of reading the copy's rotations. `view`: the
+        original pose's memory (bulk.PoseRotationView), whose pose matrices Blender's pass in
+        the viewport's depsgraph refreshes: read there, not through RNA, when it found them."""
         import bpy
 
         if self.pending is not None:  # an earlier write nobody evaluated: let Blender copy afresh
@@ -431,22 +543,49 @@ class ArmatureRuntime:
             changed = np.any(self.held != self.rotations, axis=1)
         elif not changed.any():
             return  # evaluate() checks after the evaluation that the copy holds them
-        before = bulk.pose_bone_matrices(pose_bones, self.matrices_before)
+        if view is not None and view.matrix_index is not None:
+            rows = self._first_changed_rows(view, changed[view.indices])
+            before = ("view", view.read_matrices(rows), rows)
+        else:
+            before = ("rna", bulk.pose_bone_matrices(pose_bones, self.matrices_before), changed)
         bulk.set_pose_rotations(pose_bones, self.rotations)
-        self.pending = (depsgraph.as_pointer(), frame, changed, before)
+        self.pending = (depsgraph.as_pointer(), frame, *before)
 
-    def _was_evaluated(self, pose_bones, depsgraph, frame):
+    def _first_changed_rows(self, view, changed_rows):
+        """The view's rows (of bulk.PoseRotationView) of the first bone of each rod, in chain
+        order, whose rotation changed. Blender evaluates a bone together with every bone below
+        it (each bone's evaluation waits for its parent's), so when these got new matrices, so
+        did every changed bone: at 16,000 bones one pose matrix a rod is read, not one a bone.
+        (3.4, 4.5 and 5.0 evaluate the whole pose once an action moves any bone of it; a rig
+        nothing animates is not evaluated at all: test_hair_whole_frame.py.)"""
+        if self.rod_view_rows is None:
+            self.rod_view_rows = np.searchsorted(view.indices, self.rod_bones)
+        hits = np.flatnonzero(changed_rows[self.rod_view_rows])
+        if not len(hits):
+            return hits
+        rods = np.searchsorted(self.rod_starts, hits, side="right") - 1
+        first = np.flatnonzero(np.diff(rods, prepend=-1))
+        return self.rod_view_rows[hits[first]]
+
+    def _was_evaluated(self, obj, pose_bones, depsgraph, frame):
         """After an evaluation that follows _write_evaluated: did Blender evaluate the pose with
         the rotations written into its copy? Every bone whose rotation changed must have a new
         matrix (a pose nothing animates is not evaluated again on a frame change). A write into
         another depsgraph's copy (the viewport's, while a render evaluates its own) is never
-        confirmed: False, so the caller's tag has Blender copy that armature afresh."""
+        confirmed: False, so the caller's tag has Blender copy that armature afresh. Matrices
+        read from the original pose's memory are the ones Blender copies back there after a
+        pass of the viewport's depsgraph, which is the one written (checked above)."""
         pending, self.pending = self.pending, None
         if pending is None:
             return True  # nothing was written into an evaluated copy
         if pending[0] != depsgraph.as_pointer() or pending[1] != frame:
             return False
-        _, _, changed, before = pending
+        _, _, source, before, changed = pending
+        if source == "view":
+            view = self.rotation_view
+            if not view or obj.pose is None or not view.current(obj.pose):
+                return False
+            return bool(np.all(np.any(view.read_matrices(changed) != before, axis=1)))
         after = bulk.pose_bone_matrices(pose_bones, self.matrices_after)
         return bool(np.all(np.any(after[changed] != before[changed], axis=(1, 2))))
 
@@ -501,6 +640,14 @@ class ArmatureRuntime:
         if slot is None or self.last_frame is None:
             return None
         return self.system.weights(slot)
+
+
+def _same_inputs(a, b):
+    """Two frames' predicted inputs (matrices, armature matrix, camera or None, gravity) are
+    bit for bit the same."""
+    if (a[2] is None) != (b[2] is None):
+        return False
+    return all(x is None or np.array_equal(x, y) for x, y in zip(a, b))
 
 
 def _fps(scene):

@@ -125,21 +125,89 @@ CubicBasis cubic_basis(int count, Real t) {
   return basis;
 }
 
-Real curve_length(const CubicBSpline& curve) {
-  // 8-point Gauss-Legendre on 8 sub-intervals per span: exact far below 1e-9 for
-  // any reasonable bend (the speed |M'| is smooth within a span).
-  static constexpr std::array<Real, 4> x = {0.1834346424956498, 0.5255324099163290, 0.7966664774136267,
-                                           0.9602898564975363};
-  static constexpr std::array<Real, 4> w = {0.3626837833783620, 0.3137066458778873, 0.2223810344533745,
-                                           0.1012285362903763};
-  const int pieces = 8 * (curve.count() - 3);
+namespace {
+
+// de Boor on M' (degree 2) at a fixed t, split in two: the ratios, which depend on the
+// knots alone, and their replay on control values, the same arithmetic in the same order
+// as de_boor(2, ...) (so the same bits as first_derivative).
+struct DerivativeRatios {
+  int first = 0;  // M' control point of d[0]
+  std::array<Real, 3> alpha{};
+};
+
+DerivativeRatios derivative_ratios(int count, Real t) {
+  const int spans = count - 3;
+  const auto knot = [spans](int j) { return Real(std::clamp(j + 1 - 3, 0, spans)) / Real(spans); };
+  t = std::clamp(t, Real(0), Real(1));
+  const int k = 3 + std::min(static_cast<int>(std::floor(t * spans)), spans - 1) - 1;
+  DerivativeRatios out;
+  out.first = k - 2;
+  int a = 0;
+  for (int r = 1; r <= 2; ++r) {
+    for (int j = 2; j >= r; --j) {
+      const Real lo = knot(j + k - 2);
+      out.alpha[static_cast<std::size_t>(a++)] = (t - lo) / (knot(j + 1 + k - r) - lo);
+    }
+  }
+  return out;
+}
+
+Vec3 replay(const DerivativeRatios& ratios, const Vec3* c) {
+  std::array<Vec3, 3> d = {c[ratios.first], c[ratios.first + 1], c[ratios.first + 2]};
+  d[2] = (1 - ratios.alpha[0]) * d[1] + ratios.alpha[0] * d[2];
+  d[1] = (1 - ratios.alpha[1]) * d[0] + ratios.alpha[1] * d[1];
+  d[2] = (1 - ratios.alpha[2]) * d[1] + ratios.alpha[2] * d[2];
+  return d[2];
+}
+
+// 8-point Gauss-Legendre on 8 sub-intervals per span: exact far below 1e-9 for any
+// reasonable bend (the speed |M'| is smooth within a span).
+constexpr std::array<Real, 4> kGaussX = {0.1834346424956498, 0.5255324099163290, 0.7966664774136267,
+                                         0.9602898564975363};
+constexpr std::array<Real, 4> kGaussW = {0.3626837833783620, 0.3137066458778873, 0.2223810344533745,
+                                         0.1012285362903763};
+
+// The ratios at every node of curve_length for a curve of `count` points, in its order;
+// kept for the last counts asked (the swim measures its axis's length a few times a frame).
+const std::vector<DerivativeRatios>& length_nodes(int count) {
+  thread_local std::array<std::pair<int, std::vector<DerivativeRatios>>, 4> memo;
+  thread_local std::size_t next = 0;
+  for (const auto& [n, nodes] : memo) {
+    if (n == count) return nodes;
+  }
+  const int pieces = 8 * (count - 3);
   const Real h = Real(1) / pieces;
-  Real length = 0;
+  std::vector<DerivativeRatios> nodes;
+  nodes.reserve(static_cast<std::size_t>(pieces) * 8);
   for (int p = 0; p < pieces; ++p) {
     const Real mid = (p + Real(0.5)) * h;
+    for (int q = 0; q < 4; ++q) {
+      nodes.push_back(derivative_ratios(count, mid - kGaussX[q] * h / 2));
+      nodes.push_back(derivative_ratios(count, mid + kGaussX[q] * h / 2));
+    }
+  }
+  auto& slot = memo[next];
+  next = (next + 1) % memo.size();
+  slot = {count, std::move(nodes)};
+  return slot.second;
+}
+
+}  // namespace
+
+Real curve_length(const CubicBSpline& curve) {
+  const int pieces = 8 * (curve.count() - 3);
+  const Real h = Real(1) / pieces;
+  const std::vector<DerivativeRatios>& nodes = length_nodes(curve.count());
+  const Vec3* c = curve.derivative_points().data();
+  Real length = 0;
+  std::size_t node = 0;
+  for (int p = 0; p < pieces; ++p) {
     Real piece = 0;
     for (int q = 0; q < 4; ++q) {
-      piece += w[q] * (curve.first_derivative(mid - x[q] * h / 2).norm() + curve.first_derivative(mid + x[q] * h / 2).norm());
+      const Real below = replay(nodes[node], c).norm();
+      const Real above = replay(nodes[node + 1], c).norm();
+      node += 2;
+      piece += kGaussW[q] * (below + above);
     }
     length += piece * h / 2;
   }

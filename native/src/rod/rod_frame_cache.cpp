@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <limits>
+#include <stdexcept>
 
 namespace kodawari::rod {
 
@@ -90,7 +91,7 @@ void FrameCache::thin() {
   }
 }
 
-void RodSystem::store_frame(int frame, const float* rotations) {
+FrameCache::Entry RodSystem::snapshot(const float* rotations) {
   FrameCache::Entry entry;
   entry.state_size = state_size();
   entry.state = cache_.take_buffer(entry.state_size);  // not zeroed: write_state fills every value
@@ -102,6 +103,15 @@ void RodSystem::store_frame(int frame, const float* rotations) {
       std::copy_n(rotations + 4 * static_cast<std::size_t>(bone), 4, out);
       out += 4;
     }
+  }
+  return entry;
+}
+
+void RodSystem::store_frame(int frame, const float* rotations) { cache_.store(frame, snapshot(rotations)); }
+
+void RodSystem::store_snapshot(int frame, FrameCache::Entry entry) {
+  if (entry.state_size != state_size() || entry.rotations.size() != 4 * rod_bone_count()) {
+    throw std::invalid_argument("store_snapshot: the snapshot is of another system");
   }
   cache_.store(frame, std::move(entry));
 }

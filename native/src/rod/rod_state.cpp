@@ -4,7 +4,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "kodawari/parallel.hpp"
+#include "kodawari/worker_pool.hpp"
 #include "rod_detail.hpp"
 
 namespace kodawari::rod {
@@ -143,12 +143,13 @@ void RodSystem::write_state(Real* out) const {
   // touching it from every thread halves the page-fault time.
   std::vector<std::size_t> offsets(rods_.size() + 1, 0);
   for (std::size_t r = 0; r < rods_.size(); ++r) offsets[r + 1] = offsets[r] + rod_state_size(r);
-  parallel_for_dynamic(rods_.size(), threads_, 4 * kRodsPerChunk, [&](std::size_t begin, std::size_t end) {
+  parallel_chunks(rods_.size(), threads_, 4 * kRodsPerChunk, [&](std::size_t begin, std::size_t end) {
     for (std::size_t r = begin; r < end; ++r) write_rod_state(r, out + offsets[r]);
   });
 }
 
 void RodSystem::read_state(const Real* in) {
+  ++state_revision_;
   for (std::size_t r = 0; r < rods_.size(); ++r) {
     read_rod_state(r, in);
     in += rod_state_size(r);

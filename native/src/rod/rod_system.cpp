@@ -1,17 +1,29 @@
 // RodSystem's lifecycle: validating and adding rods and colliders, reset and step
-// over every rod (in parallel), and writing each bone's rotation.
+// over every rod (in parallel), and writing each bone's rotation. The rods go to the
+// process's kept worker threads (worker_pool.hpp), not to threads started per call: a frame
+// does not wait for a thread the machine has not scheduled yet.
 #include "kodawari/rod/rod_system.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <stdexcept>
 #include <string>
 
-#include "kodawari/parallel.hpp"
+#include "kodawari/worker_pool.hpp"
 #include "rod_detail.hpp"
 
 namespace kodawari::rod {
 
 using namespace detail;
+
+namespace {
+// Definition revisions are unique in the process, so a system built where a freed one lived
+// never passes for it (RodStepAhead).
+std::uint64_t next_definition_revision() {
+  static std::atomic<std::uint64_t> counter{0};
+  return ++counter;
+}
+}  // namespace
 
 void bone_transform(const float* bone_matrices, std::size_t index, Quat& rotation, Vec3& position,
                     Eigen::Matrix<Real, 3, 3>* linear) {
@@ -80,6 +92,8 @@ std::size_t RodSystem::add_rod(RodDefinition rod) {
   states_.emplace_back();
   weights_.emplace_back(rods_.back().keys.size() + 1, Real(0));
   weights_.back()[0] = 1;
+  definition_revision_ = next_definition_revision();
+  ++state_revision_;
   return rods_.size() - 1;
 }
 
@@ -93,6 +107,7 @@ void RodSystem::set_colliders(std::vector<ColliderDefinition> colliders) {
     }
   }
   colliders_ = std::move(colliders);
+  definition_revision_ = next_definition_revision();
 }
 
 std::vector<Collider> RodSystem::world_colliders(const FrameInput& input) const {
@@ -133,8 +148,9 @@ void RodSystem::write_output(std::size_t r, float* rotations_out) {
 }
 
 void RodSystem::reset(const FrameInput& input, float* rotations_out) {
+  ++state_revision_;
   const std::vector<Collider> colliders = world_colliders(input);
-  parallel_for_dynamic(rods_.size(), threads_, kRodsPerChunk, [&](std::size_t begin, std::size_t end) {
+  parallel_chunks(rods_.size(), threads_, kRodsPerChunk, [&](std::size_t begin, std::size_t end) {
     for (std::size_t r = begin; r < end; ++r) {
       begin_frame(r, input, colliders, true);
       if (rotations_out) write_output(r, rotations_out);
@@ -142,15 +158,25 @@ void RodSystem::reset(const FrameInput& input, float* rotations_out) {
   });
 }
 
+std::vector<Collider> RodSystem::begin_step(const FrameInput& input) {
+  ++state_revision_;
+  return world_colliders(input);
+}
+
+void RodSystem::step_rods(const FrameInput& input, const std::vector<Collider>& colliders, std::size_t begin,
+                          std::size_t end, float* rotations_out) {
+  for (std::size_t r = begin; r < end; ++r) {
+    const bool fresh = !states_[r].initialised;
+    begin_frame(r, input, colliders, fresh);
+    if (!fresh) simulate(r, input, colliders);
+    if (rotations_out) write_output(r, rotations_out);
+  }
+}
+
 void RodSystem::step(const FrameInput& input, float* rotations_out) {
-  const std::vector<Collider> colliders = world_colliders(input);
-  parallel_for_dynamic(rods_.size(), threads_, kRodsPerChunk, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t r = begin; r < end; ++r) {
-      const bool fresh = !states_[r].initialised;
-      begin_frame(r, input, colliders, fresh);
-      if (!fresh) simulate(r, input, colliders);
-      if (rotations_out) write_output(r, rotations_out);
-    }
+  const std::vector<Collider> colliders = begin_step(input);
+  parallel_chunks(rods_.size(), threads_, kRodsPerChunk, [&](std::size_t begin, std::size_t end) {
+    step_rods(input, colliders, begin, end, rotations_out);
   });
 }
 
@@ -166,6 +192,34 @@ Vec3List RodSystem::joint_velocities(std::size_t r) const {
   return Vec3List(s.v.begin() + 1, s.v.end());
 }
 
+
+std::unique_ptr<RodSystem> RodSystem::twin(unsigned threads) const {
+  auto twin = std::make_unique<RodSystem>(bone_count_, threads);
+  twin->rods_ = rods_;
+  twin->colliders_ = colliders_;
+  twin->states_ = states_;
+  twin->weights_ = weights_;
+  return twin;
+}
+
+void RodSystem::copy_state_from(const RodSystem& twin) {
+  if (twin.rods_.size() != rods_.size() || twin.bone_count_ != bone_count_) {
+    throw std::invalid_argument("copy_state_from: not a twin of this system");
+  }
+  states_ = twin.states_;  // same sizes: the vectors keep their memory, no allocation
+  weights_ = twin.weights_;
+  ++state_revision_;
+}
+
+void RodSystem::swap_state(RodSystem& twin) {
+  if (twin.rods_.size() != rods_.size() || twin.bone_count_ != bone_count_) {
+    throw std::invalid_argument("swap_state: not a twin of this system");
+  }
+  states_.swap(twin.states_);
+  weights_.swap(twin.weights_);
+  ++state_revision_;
+  ++twin.state_revision_;
+}
 
 std::size_t RodSystem::rod_bone_count() const {
   std::size_t count = 0;

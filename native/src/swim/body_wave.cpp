@@ -3,8 +3,10 @@
 #include <Eigen/Dense>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <complex>
+#include <optional>
 
 #include "kodawari/ffd/bspline.hpp"
 #include "kodawari/ffd/lengths.hpp"
@@ -98,14 +100,18 @@ Real seen_wavelength(const Eigen::VectorXcd& c, const std::vector<Real>& s) {
 
 }  // namespace
 
-std::vector<Real> fitted_offsets(const Vec3List& rest, Real body_length, const BodyWave& wave, Real phase) {
+namespace {
+
+// What a body wave on one rest axis does not owe to its phase: the complex fit of the
+// control offsets per unit body length (docs/algorithms.md §2.1) and the rest curve's arc
+// length (§2.3). A swimming fish asks for the same rest axis and settings every frame.
+struct WaveShape {
+  Eigen::VectorXcd fit;
+  Real rest_curve = 0;
+};
+
+WaveShape compute_wave_shape(const Vec3List& rest, const BodyWave& wave) {
   const int n = static_cast<int>(rest.size());
-  if (n < 4) {
-    const std::vector<Real> s = arc_fractions(rest);
-    std::vector<Real> out(s.size());
-    for (std::size_t i = 0; i < s.size(); ++i) out[i] = body_length * wave_offset(wave, s[i], phase);
-    return out;
-  }
   std::vector<Real> t(kFitSamples);
   for (int j = 0; j < kFitSamples; ++j) t[j] = Real(j) / (kFitSamples - 1);
   const std::vector<Real> s = arc_fraction_at(ffd::CubicBSpline(rest), t);
@@ -158,6 +164,43 @@ std::vector<Real> fitted_offsets(const Vec3List& rest, Real body_length, const B
     k *= std::clamp(seen / wanted, Real(0.5), Real(2));
     x = complex_fit(k);
   }
+  return WaveShape{x, ffd::curve_length(ffd::CubicBSpline(rest))};
+}
+
+// The last few shapes asked for on this thread, found by their exact inputs (a path bends
+// the rest axis anew every frame: those miss and cost what they did before). The result
+// is bit for bit the one computed afresh.
+WaveShape wave_shape(const Vec3List& rest, const BodyWave& wave) {
+  struct Entry {
+    Vec3List rest;
+    std::array<Real, 5> settings;
+    WaveShape shape;
+  };
+  constexpr std::size_t kEntries = 8;
+  thread_local std::array<std::optional<Entry>, kEntries> memo;
+  thread_local std::size_t next = 0;
+  const std::array<Real, 5> settings = {wave.wavelength, wave.amplitude, wave.amplitude_head, wave.envelope_start,
+                                        wave.envelope_power};
+  for (const auto& entry : memo) {
+    if (entry && entry->settings == settings && entry->rest == rest) return entry->shape;
+  }
+  WaveShape shape = compute_wave_shape(rest, wave);
+  memo[next] = Entry{rest, settings, shape};
+  next = (next + 1) % kEntries;
+  return shape;
+}
+
+}  // namespace
+
+std::vector<Real> fitted_offsets(const Vec3List& rest, Real body_length, const BodyWave& wave, Real phase) {
+  const int n = static_cast<int>(rest.size());
+  if (n < 4) {
+    const std::vector<Real> s = arc_fractions(rest);
+    std::vector<Real> out(s.size());
+    for (std::size_t i = 0; i < s.size(); ++i) out[i] = body_length * wave_offset(wave, s[i], phase);
+    return out;
+  }
+  const Eigen::VectorXcd x = wave_shape(rest, wave).fit;
   const std::complex<Real> turn = std::polar(body_length, phase + wave.phase_offset);
   std::vector<Real> out(static_cast<std::size_t>(n));
   for (int i = 0; i < n; ++i) out[static_cast<std::size_t>(i)] = (turn * x[i]).imag();
@@ -205,7 +248,7 @@ Vec3List body_axis(const Vec3List& rest, const Vec3& bend_direction, Real body_l
   // The body follows the smooth B-spline, which cuts the bent polygon's corners and
   // so comes out shorter than at rest; scale the kept distances until the curve's
   // own arc length is the rest one again (converges in a few passes).
-  const Real rest_curve = ffd::curve_length(ffd::CubicBSpline(rest));
+  const Real rest_curve = wave_shape(rest, wave).rest_curve;
   Real scale = 1.0;
   for (int pass = 0; pass < 4; ++pass) {
     const Real now = ffd::curve_length(ffd::CubicBSpline(placed));

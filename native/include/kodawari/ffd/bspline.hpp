@@ -19,6 +19,8 @@ class CubicBSpline {
 
   int count() const { return static_cast<int>(points_.size()); }
   const Vec3List& control_points() const { return points_; }
+  // Control points of M' (degree 2 on the knots U[1 .. n + 2]).
+  const Vec3List& derivative_points() const { return first_; }
 
   Vec3 point(Real t) const;
   Vec3 first_derivative(Real t) const;

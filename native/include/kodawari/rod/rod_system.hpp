@@ -19,6 +19,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -142,6 +143,12 @@ class RodSystem {
   // Advances one frame (frame_dt seconds) and writes each rod bone's rotation
   // (w, x, y, z) into rotations_out (B x 4); other rows are left untouched.
   void step(const FrameInput& input, float* rotations_out);
+  // step() in parts, for a caller that hands the rods to threads of its own (RodStepAhead):
+  // begin_step() once, then step_rods() over disjoint ranges covering [0, rod_count()), from
+  // any threads. Each rod gets the arithmetic step() gives it.
+  std::vector<Collider> begin_step(const FrameInput& input);
+  void step_rods(const FrameInput& input, const std::vector<Collider>& colliders, std::size_t begin, std::size_t end,
+                 float* rotations_out);
 
   std::size_t rod_count() const { return rods_.size(); }
   std::size_t bone_count() const { return bone_count_; }
@@ -165,11 +172,27 @@ class RodSystem {
   // `rotations` (B x 4, as written by step/reset); recall_frame() loads a frame's state
   // (when load_state is true) and writes its rod-bone rows into rotations_out (if not null).
   void store_frame(int frame, const float* rotations);
+  // What store_frame() caches, made now and cached later (by store_snapshot, in this system or
+  // its twin: RodStepAhead makes it on its own thread).
+  FrameCache::Entry snapshot(const float* rotations);
+  void store_snapshot(int frame, FrameCache::Entry entry);
   bool recall_frame(int frame, float* rotations_out, bool load_state);
   FrameCache& frame_cache() { return cache_; }
   const FrameCache& frame_cache() const { return cache_; }
   // Number of rod bones (rows of a cached frame's rotations).
   std::size_t rod_bone_count() const;
+
+  // Counters of change, for RodStepAhead (rod_step_ahead.hpp): the state revision moves with
+  // every change of the simulation state (reset, step, a loaded or recalled state, an exchange),
+  // the definition revision with every change of the rods or colliders.
+  std::uint64_t state_revision() const { return state_revision_; }
+  std::uint64_t definition_revision() const { return definition_revision_; }
+  // A system with the same rods, colliders and state, without cached frames (a copy, not
+  // re-added rods: add_rod normalises, and a twin must step bit for bit as this system does).
+  std::unique_ptr<RodSystem> twin(unsigned threads) const;
+  // The simulation state of a twin copied into this system, or exchanged with it (no copy).
+  void copy_state_from(const RodSystem& twin);
+  void swap_state(RodSystem& twin);
 
  private:
   void begin_frame(std::size_t r, const FrameInput& input, const std::vector<Collider>& colliders, bool reset);
@@ -189,6 +212,8 @@ class RodSystem {
   std::vector<std::vector<Real>> weights_;
   std::vector<ColliderDefinition> colliders_;
   FrameCache cache_;
+  std::uint64_t state_revision_ = 0;
+  std::uint64_t definition_revision_ = 0;
 };
 
 // Matrix of pose bone `index` from the foreach_get buffer, with rotation and position.
