@@ -40,6 +40,19 @@ def run_worker(*args, cwd):
     return run_blender(script, *args, cwd=cwd)
 
 
+def rendered_pixels(path):
+    """The RGBA floats of a rendered image file (read in the tests' own process)."""
+    import numpy as np
+
+    image = bpy.data.images.load(path)
+    try:
+        out = np.empty(len(image.pixels), dtype=np.float32)
+        image.pixels.foreach_get(out)
+    finally:
+        bpy.data.images.remove(image)
+    return out
+
+
 def _enable_addon():
     import addon_utils
 

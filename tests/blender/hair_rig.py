@@ -51,6 +51,32 @@ def add_camera(scene, name, location, look_at=(0.0, 0.0, 1.7), active=True):
     return cam
 
 
+def key_head(obj, keys, by="action"):
+    """Keys the Head bone (Pose Mode) at `keys`, (frame, location, rotation_euler) triples.
+    by="constraint": keys a HeadControl bone with the head's rest instead, which the head
+    copies (Copy Transforms, local), as in rigs whose head a control moves. The keyed bone."""
+    head = driver = obj.pose.bones["Head"]
+    head.rotation_mode = "XYZ"
+    if by == "constraint":
+        bpy.ops.object.mode_set(mode="EDIT")
+        control = obj.data.edit_bones.new("HeadControl")
+        rest = obj.data.edit_bones["Head"]
+        control.head, control.tail, control.roll = rest.head, rest.tail, rest.roll
+        control.parent = rest.parent
+        bpy.ops.object.mode_set(mode="POSE")
+        head = obj.pose.bones["Head"]
+        driver = obj.pose.bones["HeadControl"]
+        driver.rotation_mode = "XYZ"
+        con = head.constraints.new("COPY_TRANSFORMS")
+        con.target, con.subtarget = obj, "HeadControl"
+        con.target_space = con.owner_space = "LOCAL"
+    for frame, location, rotation in keys:
+        driver.location, driver.rotation_euler = location, rotation
+        driver.keyframe_insert("location", frame=frame)
+        driver.keyframe_insert("rotation_euler", frame=frame)
+    return driver
+
+
 def select_only(obj, names):
     from kodawari.hair import chains
 

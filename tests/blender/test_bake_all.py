@@ -13,7 +13,7 @@ import bpy
 import numpy as np
 import pytest
 from bake_scenes import hair_rig, swimming_fish
-from farm_worker import run_blender, run_worker
+from farm_worker import rendered_pixels, run_blender, run_worker
 from fish_helpers import activate, make_fish
 from gait_scene import horse
 from hair_rig import add_camera
@@ -49,16 +49,6 @@ def _shot(scene, path):
     bpy.ops.wm.save_as_mainfile(filepath=path)
 
 
-def _pixels(path):
-    image = bpy.data.images.load(path)
-    try:
-        out = np.empty(len(image.pixels), dtype=np.float32)
-        image.pixels.foreach_get(out)
-    finally:
-        bpy.data.images.remove(image)
-    return out
-
-
 def test_a_baked_shot_renders_the_same_without_the_addon(empty_scene, tmp_path):
     shot = tmp_path / "shots" / "shot_010.blend"
     shot.parent.mkdir()
@@ -88,7 +78,7 @@ def test_a_baked_shot_renders_the_same_without_the_addon(empty_scene, tmp_path):
             cwd=elsewhere,
         )
         assert code == 0, output
-        images[addon] = [_pixels(str(out / f"{frame:04d}.png")) for frame in FRAMES]
+        images[addon] = [rendered_pixels(str(out / f"{frame:04d}.png")) for frame in FRAMES]
     for frame, with_addon, without in zip(FRAMES, images["addon"], images["no-addon"]):
         assert np.array_equal(with_addon, without), f"frame {frame} differs without the add-on"
     first, *others = images["no-addon"]

@@ -8,7 +8,7 @@ Each step runs in a fresh Blender process (the program or the bpy module running
 import bpy
 import numpy as np
 from bake_scenes import swimming_fish
-from farm_worker import run_worker
+from farm_worker import rendered_pixels, run_worker
 from fish_helpers import activate
 from hair_rig import add_camera
 
@@ -16,20 +16,10 @@ FRAMES = (1, 6, 12)
 SAVED_ON = 6
 
 
-def _pixels(path):
-    image = bpy.data.images.load(path)
-    try:
-        out = np.empty(len(image.pixels), dtype=np.float32)
-        image.pixels.foreach_get(out)
-    finally:
-        bpy.data.images.remove(image)
-    return out
-
-
 def _render(blend, out, addon, cwd):
     code, output = run_worker("render", str(blend), str(out), addon, *map(str, FRAMES), cwd=cwd)
     assert code == 0, output
-    return {frame: _pixels(str(out / f"{frame:04d}.png")) for frame in FRAMES}
+    return {frame: rendered_pixels(str(out / f"{frame:04d}.png")) for frame in FRAMES}
 
 
 def test_a_live_fish_keeps_its_saved_pose_without_the_addon_and_swims_again_with_it(

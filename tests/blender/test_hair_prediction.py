@@ -10,7 +10,7 @@ caught and solved again in the same frame)."""
 import bpy
 import numpy as np
 import pytest
-from hair_rig import add_camera, chain_bones, make_rig, select_only
+from hair_rig import add_camera, chain_bones, key_head, make_rig, select_only
 
 HEAD_KEYS = (
     (1, (0.0, 0.0, 0.0), (0.0, 0.0, 0.0)),
@@ -30,27 +30,7 @@ def _rig(scene, head_by="action"):
     assert bpy.ops.kodawari.rod_add() == {"FINISHED"}
     obj.kodawari_hair.rods[0].stiffness = 0.3
     obj.pose.bones["Root"].rotation_quaternion = (0.9962, 0.0, 0.0872, 0.0)  # 10 deg, static
-    head = obj.pose.bones["Head"]
-    head.rotation_mode = "XYZ"
-    driver = head
-    if head_by == "constraint":
-        # A control bone with the head's rest, keyed; the head copies its local transform.
-        bpy.ops.object.mode_set(mode="EDIT")
-        control = obj.data.edit_bones.new("HeadControl")
-        rest = obj.data.edit_bones["Head"]
-        control.head, control.tail, control.roll = rest.head, rest.tail, rest.roll
-        control.parent = rest.parent
-        bpy.ops.object.mode_set(mode="POSE")
-        head = obj.pose.bones["Head"]
-        driver = obj.pose.bones["HeadControl"]
-        driver.rotation_mode = "XYZ"
-        con = head.constraints.new("COPY_TRANSFORMS")
-        con.target, con.subtarget = obj, "HeadControl"
-        con.target_space = con.owner_space = "LOCAL"
-    for frame, location, rotation in HEAD_KEYS:
-        driver.location, driver.rotation_euler = location, rotation
-        driver.keyframe_insert("location", frame=frame)
-        driver.keyframe_insert("rotation_euler", frame=frame)
+    key_head(obj, HEAD_KEYS, by=head_by)
     add_camera(scene, "Front", (0, -4, 1.7))
     scene.frame_start, scene.frame_end = 1, 40
     bpy.ops.object.mode_set(mode="OBJECT")

@@ -10,7 +10,7 @@ evaluation, bit for bit the pose the plain path (every frame solved in its own h
 import bpy
 import numpy as np
 import pytest
-from hair_rig import add_camera, chain_bones, make_rig, select_only
+from hair_rig import add_camera, chain_bones, key_head, make_rig, select_only
 
 CHAINS = (
     ("Ahoge", (0.0, 0.0, 1.8), (0.0, 0.0, 1.0), 5),
@@ -42,24 +42,7 @@ def _rig(scene, head_by="action"):
     for frame, location in ((1, (0, -4, 1.7)), (15, (4, 0, 1.7)), (30, (0, 4, 1.7))):
         camera.location = location
         camera.keyframe_insert("location", frame=frame)
-    head = driver = obj.pose.bones["Head"]
-    head.rotation_mode = "XYZ"
-    if head_by == "constraint":
-        bpy.ops.object.mode_set(mode="EDIT")
-        control = obj.data.edit_bones.new("HeadControl")
-        rest = obj.data.edit_bones["Head"]
-        control.head, control.tail, control.parent = rest.head, rest.tail, rest.parent
-        bpy.ops.object.mode_set(mode="POSE")
-        head = obj.pose.bones["Head"]
-        driver = obj.pose.bones["HeadControl"]
-        driver.rotation_mode = "XYZ"
-        con = head.constraints.new("COPY_TRANSFORMS")
-        con.target, con.subtarget = obj, "HeadControl"
-        con.target_space = con.owner_space = "LOCAL"
-    for frame, location, rotation in HEAD_KEYS:
-        driver.location, driver.rotation_euler = location, rotation
-        driver.keyframe_insert("location", frame=frame)
-        driver.keyframe_insert("rotation_euler", frame=frame)
+    driver = key_head(obj, HEAD_KEYS, by=head_by)
     scene.frame_start, scene.frame_end = 1, 60
     bpy.ops.object.mode_set(mode="OBJECT")
     return obj, driver
