@@ -123,17 +123,22 @@ def _pose_channel_floats(pose_bone):
     return np.array(values, np.float32)
 
 
-def _quat_offset(pose_bone):
-    """Byte offset of quat[0] in this bone's bPoseChannel, or None."""
+def _runs_matching(pose_bone, want):
+    """Float indices in this bone's bPoseChannel (its first _POSE_CHANNEL_SEARCH_BYTES) where
+    the float32 run `want` lies, in order; empty without an address."""
     import ctypes
 
     address = pose_bone.as_pointer()
     if not address:
-        return None
+        return np.empty(0, np.int64)
     memory = np.frombuffer(ctypes.string_at(address, _POSE_CHANNEL_SEARCH_BYTES), np.float32)
-    want = _pose_channel_floats(pose_bone)
     windows = np.lib.stride_tricks.sliding_window_view(memory, len(want))
-    found = np.flatnonzero(np.all(windows == want, axis=1))
+    return np.flatnonzero(np.all(windows == want, axis=1))
+
+
+def _quat_offset(pose_bone):
+    """Byte offset of quat[0] in this bone's bPoseChannel, or None."""
+    found = _runs_matching(pose_bone, _pose_channel_floats(pose_bone))
     # The first match: a later one may be the next channel in memory (a bone at rest looks
     # like any other); the offsets of three channels must agree (PoseRotationView.create).
     return None if not len(found) else int(found[0] + _POSE_CHANNEL_QUAT) * 4
@@ -141,15 +146,8 @@ def _quat_offset(pose_bone):
 
 def _matrix_offsets(pose_bone):
     """Byte offsets in this bone's bPoseChannel where its pose matrix (16 floats) lies."""
-    import ctypes
-
-    address = pose_bone.as_pointer()
-    if not address:
-        return set()
-    memory = np.frombuffer(ctypes.string_at(address, _POSE_CHANNEL_SEARCH_BYTES), np.float32)
     want = np.array(pose_bone.matrix, np.float32).T.reshape(-1)
-    windows = np.lib.stride_tricks.sliding_window_view(memory, _POSE_MATRIX_FLOATS)
-    return {int(i) * 4 for i in np.flatnonzero(np.all(windows == want, axis=1))}
+    return {int(i) * 4 for i in _runs_matching(pose_bone, want)}
 
 
 class PoseRotationView:

@@ -486,6 +486,16 @@ class LegIk {
     return std::atan2(ahead.z(), std::hypot(ahead.x(), ahead.y()));
   }
 
+  // The worst ratio to the 3x rule at the planted frames of [from, to] (within the bake).
+  Real planted_rule(int from, int to) const {
+    const int frames = static_cast<int>(in_.target_speed.size());
+    Real worst = 0;
+    for (int f = std::max(1, from); f <= std::min(frames - 1, to); ++f) {
+      if (feet_.contact[f * kLegCount + leg_] > 0) worst = std::max(worst, snap_ratio(f));
+    }
+    return worst;
+  }
+
   // At the touch-down of the stance [f, g): the change into it and its first change.
   Real touchdown_ratio(int f, int g) const { return std::max(snap_ratio(f), f + 1 < g ? snap_ratio(f + 1) : 0); }
   // At the lift-off of the stance [a, b): its last two changes.
@@ -631,13 +641,7 @@ class LegIk {
                      kIkTolerance, allowed, kEvenIterations)) {
       return false;
     }
-    auto rule = [&] {  // the worst ratio to the 3x rule at the planted frames it touches
-      Real worst = 0;
-      for (int f = std::max(1, start - 2); f <= std::min(frames - 1, end + 2); ++f) {
-        if (feet_.contact[f * kLegCount + leg_] > 0) worst = std::max(worst, snap_ratio(f));
-      }
-      return worst;
-    };
+    auto rule = [&] { return planted_rule(start - 2, end + 2); };  // at the planted frames it touches
     const Real rule_before = std::max(rule(), Real(1));
     for (int k = 0; k < count; ++k) record(start + k, goals3[k], angles.data() + k * n_, errors[k]);
     if (rule() <= rule_before) return true;
@@ -710,13 +714,7 @@ class LegIk {
     const Real error = solve_dls(held, local_goal(lift, goal), 4 * in_.ccd_iterations, kIkTolerance, pose).error;
     const Real old_error = out_.ik_error[lift * 4 + leg_];
     if (error > std::max(old_error, kSwingIkTolerance)) return false;
-    auto rule = [&] {
-      Real worst = 0;
-      for (int f = std::max(1, stance.first); f <= std::min(frames - 1, lift + 3); ++f) {
-        if (feet_.contact[f * kLegCount + leg_] > 0) worst = std::max(worst, snap_ratio(f));
-      }
-      return worst;
-    };
+    auto rule = [&] { return planted_rule(stance.first, lift + 3); };
     const Real worst_before = rule();
     std::vector<Real> old_pose(solved_pose(lift), solved_pose(lift) + n_);
     record(lift, goal, pose, error);
