@@ -185,7 +185,9 @@ def test_a_state_changed_while_the_thread_copies_it_waits_and_each_side_steps_th
     played, out = _started()
     system, system_out = _started()
     ahead = kn.RodStepAhead()
-    ahead.start(system, **_inputs(3))  # the first start makes the twin; later ones copy on the thread
+    ahead.start(
+        system, **_inputs(3)
+    )  # the first start makes the twin; later ones copy on the thread
     assert ahead.finish(system_out) and ahead.adopt(system)
     played.step(rotations_out=out, **_inputs(3))
     for frame in range(4, 12):
