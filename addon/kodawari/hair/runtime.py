@@ -226,6 +226,7 @@ class ArmatureRuntime:
         others = sorted(set(range(self.bone_count)) - set(rod_bones))
         self.other_bones = others if len(others) * SPARSE_READ_RATIO <= self.bone_count else None
         self.last_frame = None
+        self.counted = None  # the frame whose pre-evaluation handler counted the bones (get)
 
     # -- one frame -------------------------------------------------------------
     def _read_matrices(self, pose_bones):
@@ -748,14 +749,24 @@ def _replay(scene, first, last):
             wm.progress_end()
 
 
-def get(obj, build=True):
-    """The runtime of an armature object, built (or rebuilt after a change) on demand."""
+def get(obj, build=True, counted=None):
+    """The runtime of an armature object, built (or rebuilt after a change) on demand.
+    `counted`: a token (the frame being set) under which the bones were already counted: a
+    frame's post-evaluation handler does not count them again after its pre-evaluation one
+    (Blender's pass adds or removes no bones; counting walks the channel list: 0.3 ms at 16,000
+    bones)."""
     key = obj.as_pointer()
     rt = _runtimes.get(key)
     if rt is not None and (
-        rt.data_pointer != obj.data.as_pointer() or rt.bone_count != len(obj.pose.bones)
+        rt.data_pointer != obj.data.as_pointer()
+        or (
+            (counted is None or rt.counted != counted)
+            and rt.bone_count != len(obj.pose.bones)
+        )
     ):
         rt = None  # another armature at a freed object's address, or bones added/removed: rebuild
+    if rt is not None:
+        rt.counted = None
     if rt is None and build:
         rt = ArmatureRuntime(obj)
         _runtimes[key] = rt
@@ -784,7 +795,7 @@ def evaluate_scene(scene, depsgraph=None):
     for obj in hair_armatures(scene):
         rt = None
         try:
-            rt = get(obj)
+            rt = get(obj, counted=(scene.as_pointer(), scene.frame_current))
             rt.evaluate(obj, scene, scene.frame_current, depsgraph)
         except ValueError as exc:  # e.g. a collapsed (zero-scale) armature: say why, keep the pose
             if rt is not None:
@@ -809,6 +820,7 @@ def show_cached_frames(scene):
         rt = get(obj, build=False)
         if rt is None:
             continue
+        rt.counted = (scene.as_pointer(), scene.frame_current)  # for this frame's evaluate_scene
         try:
             rt.show_cached(obj, scene, scene.frame_current)
         except Exception:  # noqa: BLE001 - frame_change_post evaluates this frame again and reports
