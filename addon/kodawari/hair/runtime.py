@@ -759,10 +759,7 @@ def get(obj, build=True, counted=None):
     rt = _runtimes.get(key)
     if rt is not None and (
         rt.data_pointer != obj.data.as_pointer()
-        or (
-            (counted is None or rt.counted != counted)
-            and rt.bone_count != len(obj.pose.bones)
-        )
+        or ((counted is None or rt.counted != counted) and rt.bone_count != len(obj.pose.bones))
     ):
         rt = None  # another armature at a freed object's address, or bones added/removed: rebuild
     if rt is not None:
