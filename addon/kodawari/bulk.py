@@ -254,6 +254,10 @@ class PoseRotationView:
         """rotations (B, 4) float32 for every bone; the view's bones are written."""
         self.memory[self.index] = rotations[self.indices]
 
+    def write_rows(self, rows):
+        """rows (N, 4) float32, one a view's bone (rotations[indices], already gathered)."""
+        self.memory[self.index] = rows
+
     def read_matrices(self, rows):
         """The pose matrices of the view's bones at `rows` (indices into `indices`) as Blender's
         last evaluation in the viewport's depsgraph left them: float32 (len(rows), 16) in

@@ -278,12 +278,20 @@ class ArmatureRuntime:
             # (Blender's pass writes back pose matrices, not rotations; animated rotations would
             # show in the evaluated copy, checked below): the memory is read again only when the
             # rotations are not the ones written for this very frame.
-            mine = self.rotations[view.indices]
-            holds = (
-                written is not None
-                and written[0] == self.last_frame
-                and np.array_equal(written[1], mine)
-            ) or np.array_equal(view.read(), mine)
+            # (Every row compared first, a copy without a gather: rows of other bones read since
+            # from the evaluated pose may differ, and then the rod bones' rows alone decide.)
+            mine = None
+            if written is not None and written[0] == self.last_frame:
+                if np.array_equal(written[1], self.rotations):
+                    holds = True
+                else:
+                    mine = self.rotations[view.indices]
+                    holds = np.array_equal(written[1][view.indices], mine)
+            else:
+                holds = False
+            if not holds:
+                mine = self.rotations[view.indices] if mine is None else mine
+                holds = np.array_equal(view.read(), mine)
         else:
             holds = self._holds(obj.pose.bones)
         if not holds:
@@ -304,7 +312,7 @@ class ArmatureRuntime:
             held and self._was_evaluated(obj, evaluated.pose.bones, depsgraph, self.last_frame)
         ):
             self.pending = None
-            if view is not None and not np.array_equal(view.read(), mine):
+            if view is not None and not np.array_equal(view.read(), self.rotations[view.indices]):
                 view.write(self.rotations)  # the read skipped above was needed after all
             _tag(obj)
 
@@ -362,11 +370,12 @@ class ArmatureRuntime:
         view = self._original_view(obj)
         if view is not None:
             # The rod bones' rotations in Blender's memory (no RNA: nothing tagged, no update).
+            rows = self.rotations[view.indices]  # gathered once, written and kept as is
             changed = np.zeros(self.bone_count, bool)
-            changed[view.indices] = np.any(view.read() != self.rotations[view.indices], axis=1)
+            changed[view.indices] = np.any(view.read() != rows, axis=1)
             if changed.any():
-                view.write(self.rotations)
-            self.original_written = (frame, self.rotations[view.indices])
+                view.write_rows(rows)
+            self.original_written = (frame, self.rotations.copy())
             self._write_evaluated(obj, frame, changed, view)
             return True
         if not self._holds(pose_bones):
