@@ -178,6 +178,7 @@ class ArmatureRuntime:
         self.rod_bones = np.array(rod_bones, dtype=np.int64)
         self.rod_starts = np.array(rod_starts, dtype=np.int64)
         self.rod_view_rows = None  # rod_bones' rows in the pose view (_first_changed_rows)
+        self.rod_of_bone = None
         self.matrices = np.zeros((self.bone_count, 16), np.float32)
         self.rotations = np.empty((self.bone_count, 4), np.float32)
         self.held = np.empty((self.bone_count, 4), np.float32)  # rotations a pose holds now
@@ -273,6 +274,7 @@ class ArmatureRuntime:
         evaluation or a chain at rest. Without a depsgraph the tag is unconditional."""
         view = self._original_view(obj)
         written, self.original_written = self.original_written, None
+        mine = None  # rotations[view.indices], once gathered
         if view is not None:
             # What show_cached() wrote into the original before this frame's pass is still there
             # (Blender's pass writes back pose matrices, not rotations; animated rotations would
@@ -280,10 +282,9 @@ class ArmatureRuntime:
             # rotations are not the ones written for this very frame.
             # (Every row compared first, a copy without a gather: rows of other bones read since
             # from the evaluated pose may differ, and then the rod bones' rows alone decide.)
-            mine = None
             if written is not None and written[0] == self.last_frame:
                 if np.array_equal(written[1], self.rotations):
-                    holds = True
+                    holds, mine = True, written[2]  # the rows written, gathered then
                 else:
                     mine = self.rotations[view.indices]
                     holds = np.array_equal(written[1][view.indices], mine)
@@ -306,7 +307,7 @@ class ArmatureRuntime:
         held = (
             depsgraph is not None
             and evaluated.pose is not None
-            and self._evaluated_holds(evaluated.pose, view)
+            and self._evaluated_holds(evaluated.pose, view, mine)
         )
         if not (
             held and self._was_evaluated(obj, evaluated.pose.bones, depsgraph, self.last_frame)
@@ -316,13 +317,14 @@ class ArmatureRuntime:
                 view.write(self.rotations)  # the read skipped above was needed after all
             _tag(obj)
 
-    def _evaluated_holds(self, pose, original_view):
+    def _evaluated_holds(self, pose, original_view, rows=None):
         """True when the evaluated pose holds the rotations to write: its rod bones read in its
-        own memory (_evaluated_view) where that is confirmed, else every bone through RNA."""
+        own memory (_evaluated_view) where that is confirmed, else every bone through RNA.
+        `rows`: rotations[original_view.indices] when already gathered (the same bones)."""
         view = self._evaluated_view(pose, original_view)
         if view is None:
             return self._holds(pose.bones)
-        return np.array_equal(view.read(), self.rotations[view.indices])
+        return np.array_equal(view.read(), self.rotations[view.indices] if rows is None else rows)
 
     def _evaluated_view(self, pose, original_view):
         """The rod bones' rotations in the memory of an evaluated copy's `pose`
@@ -375,8 +377,8 @@ class ArmatureRuntime:
             changed[view.indices] = np.any(view.read() != rows, axis=1)
             if changed.any():
                 view.write_rows(rows)
-            self.original_written = (frame, self.rotations.copy())
-            self._write_evaluated(obj, frame, changed, view)
+            self.original_written = (frame, self.rotations.copy(), rows)
+            self._write_evaluated(obj, frame, changed, view, rows)
             return True
         if not self._holds(pose_bones):
             bulk.set_pose_rotations(pose_bones, self.rotations)
@@ -580,7 +582,7 @@ class ArmatureRuntime:
         if ahead is None or ahead[1] != frame or not self.ahead.store(self.system, frame):
             self.system.store_frame(frame, self.rotations)
 
-    def _write_evaluated(self, obj, frame, changed=None, view=None):
+    def _write_evaluated(self, obj, frame, changed=None, view=None, gathered=None):
         """Writes the rotations into the viewport's evaluated armature too: when the frame change
         re-evaluates the pose (an animated parent), it does so with them and without copying the
         whole object again. Whether it did is checked after the evaluation (_was_evaluated);
@@ -588,7 +590,8 @@ class ArmatureRuntime:
         `changed`: the bones whose rotation the original pose just changed (the evaluated copy
         held what the original held), instead of reading the copy's rotations. `view`: the
         original pose's memory (bulk.PoseRotationView), whose pose matrices Blender's pass in
-        the viewport's depsgraph refreshes: read there, not through RNA, when it found them."""
+        the viewport's depsgraph refreshes: read there, not through RNA, when it found them.
+        `gathered`: the rotations of the view's bones, already gathered (rotations[view.indices])."""
         import bpy
 
         if self.pending is not None:  # an earlier write nobody evaluated: let Blender copy afresh
@@ -614,7 +617,9 @@ class ArmatureRuntime:
         else:
             before = ("rna", bulk.pose_bone_matrices(pose_bones, self.matrices_before), changed)
         evaluated_view = self._evaluated_view(evaluated.pose, view)
-        if evaluated_view is not None:
+        if evaluated_view is not None and gathered is not None:
+            evaluated_view.write_rows(gathered)  # the same bones as the original's view
+        elif evaluated_view is not None:
             evaluated_view.write(self.rotations)  # its rod bones; no RNA update, nothing tagged
         else:
             bulk.set_pose_rotations(pose_bones, self.rotations)
@@ -629,10 +634,14 @@ class ArmatureRuntime:
         nothing animates is not evaluated at all: test_hair_whole_frame.py.)"""
         if self.rod_view_rows is None:
             self.rod_view_rows = np.searchsorted(view.indices, self.rod_bones)
+            # which rod each of rod_bones belongs to, once (not a search over every hit a frame)
+            self.rod_of_bone = (
+                np.searchsorted(self.rod_starts, np.arange(len(self.rod_bones)), side="right") - 1
+            )
         hits = np.flatnonzero(changed_rows[self.rod_view_rows])
         if not len(hits):
             return hits
-        rods = np.searchsorted(self.rod_starts, hits, side="right") - 1
+        rods = self.rod_of_bone[hits]
         first = np.flatnonzero(np.diff(rods, prepend=-1))
         return self.rod_view_rows[hits[first]]
 
