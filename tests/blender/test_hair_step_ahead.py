@@ -195,3 +195,21 @@ def test_rotations_written_in_the_evaluated_copys_memory_show_the_rna_paths_pose
     seen, _ = _play_session("action", ahead=True, views_used=used)
     _assert_same(seen, through_rna)
     assert used[0] == 0 and used[1] > len(SESSION), f"the copy's memory used {used[1]} times"
+
+
+def test_a_rig_whose_few_input_bones_are_read_one_by_one_shows_the_same_poses(empty_scene):
+    """Large rigs read their few input and other bones one by one (runtime.SPARSE_READ_RATIO:
+    16,000 rod bones under a head), and then keep the predicted rotations through the check
+    after the pass without restoring them: the session, solved ahead or not, shows bit for bit
+    the poses of this small rig read in bulk."""
+    from kodawari.hair import runtime
+
+    plain, _ = _play_session("action", ahead=False)
+    ratio = runtime.SPARSE_READ_RATIO
+    runtime.SPARSE_READ_RATIO = 1  # every bone but the rods' is "few"
+    try:
+        for ahead in (False, True):
+            seen, _ = _play_session("action", ahead=ahead)
+            _assert_same(seen, plain)
+    finally:
+        runtime.SPARSE_READ_RATIO = ratio

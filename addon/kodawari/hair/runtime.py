@@ -563,8 +563,12 @@ class ArmatureRuntime:
             self.last_frame = prediction.previous
             return False
         armature_matrix, camera, gravity = self._inputs(obj, scene, frame, depsgraph)
-        rods = self.rod_bones
-        self.rotations[rods] = prediction.rotations[rods]
+        if self.other_bones is None:
+            # Every bone's rotation was just read (a rig mostly of other bones): the rod bones'
+            # rows back to the predicted frame's. Read one by one, the other bones' rows only
+            # were touched, and the rod bones' rows are still the prediction's.
+            rods = self.rod_bones
+            self.rotations[rods] = prediction.rotations[rods]
         wrong = prediction.mismatch(
             self.matrices[self.input_bones], armature_matrix, camera, gravity
         )
