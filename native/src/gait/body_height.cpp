@@ -9,14 +9,6 @@ namespace kodawari::gait::stages {
 namespace {
 
 constexpr Real kMaxDropPitch = 5 * kPi / 180;  // most pitch lowering for reach may add
-// From this frame rate on, the body follows its feet (docs/algorithms.md §4.7): the
-// lowering for reach is smoothed over one frame instead of 0.08 s, clipped at zero by a
-// softplus kSoftClip x leg length wide. A 0.08 s level spans a small animal's whole
-// galloping stance, so its leg met the reach margin nearly straight at touch-down and
-// lift-off and folded there (240 fps: 11-13.5 deg a frame on fox-sized rigs); below this
-// rate a stance lasts 1-4 frames and a body following it would move in steps.
-constexpr Real kFollowFeetFps = 120;
-constexpr Real kSoftClip = 0.05;
 
 // Bob (seed: measured body bob replayed) as a dip accumulated in phase, so a change of
 // cycle time never makes it jump; faded in from a stand.
@@ -56,11 +48,6 @@ void envelope(std::vector<Real>& drop, int radius) {
   drop.swap(smooth);
 }
 
-// max(0, x) with a rounded corner of width w (softplus, never below max(0, x)): the
-// lowering for reach sets in with no kink in the body's height, so a root that follows
-// its feet frame by frame still moves smoothly.
-Real soft_clip(Real x, Real w) { return x > 30 * w ? x : w * std::log1p(std::exp(x / w)); }
-
 }  // namespace
 
 BodyHeight plan_body_height(const BakeInput& in, const LegGeometry& legs, const BodyTrack& track,
@@ -70,7 +57,6 @@ BodyHeight plan_body_height(const BakeInput& in, const LegGeometry& legs, const 
   height.bob = plan_bob(in, track, legs, frames);
   height.drop_fore.resize(frames);
   height.drop_hind.resize(frames);
-  const bool follow_feet = in.fps >= kFollowFeetFps;
   // Lowered wherever a foot, planted or swinging, would be out of its leg's reach, fore
   // and hind apart. Swinging feet count too: a hoof just lifted far behind its root (at
   // 24 fps a frame can find it there) or about to land far ahead must be reachable.
@@ -88,8 +74,7 @@ BodyHeight plan_body_height(const BakeInput& in, const LegGeometry& legs, const 
         const Real r = kReachMargin * legs.reach_tables[leg].at(std::atan2(-std::max(h, Real(1e-3)), dx));
         h = std::min(root_z - foot.z(), std::sqrt(std::max(Real(0), r * r - dx * dx)));
       }
-      const Real over = (root_z - foot.z()) - h;  // how far the root is above where it reaches
-      const Real lower = follow_feet ? soft_clip(over, kSoftClip * legs.leg_length) : std::max(Real(0), over);
+      const Real lower = std::max(Real(0), (root_z - foot.z()) - h);
       need[is_fore(leg) ? 0 : 1] = std::max(need[is_fore(leg) ? 0 : 1], lower);
     }
     height.drop_fore[f] = need[0];
@@ -106,7 +91,7 @@ BodyHeight plan_body_height(const BakeInput& in, const LegGeometry& legs, const 
     height.drop_fore[f] = std::max(fore, hind - cap);
     height.drop_hind[f] = std::max(hind, fore - cap);
   }
-  const int radius = follow_feet ? 1 : std::max(1, static_cast<int>(std::lround(0.08 * in.fps)));
+  const int radius = std::max(1, static_cast<int>(std::lround(0.08 * in.fps)));
   envelope(height.drop_fore, radius);
   envelope(height.drop_hind, radius);
   return height;
