@@ -240,6 +240,36 @@ def find_legs_from_feet(armature, foot_names):
     return legs
 
 
+def with_shoulders(armature, legs):
+    """Each fore leg takes in its shoulder blade where the rig has one (docs/algorithms.md
+    §4.11): the bone its chain hangs from, when no other leg hangs from it (the spine and
+    chest are shared) and the leg's root lies below its head (a scapula or clavicle runs
+    down to the shoulder joint; a bone running sideways or up is not one), while the
+    chain stays within 6 bones. A small animal's fore leg swings through a wide angle in
+    a few frames; its shoulder blade carries part of that turn and keeps the leg below it
+    off full stretch, as a quadruped's mobile scapula does. Returns a new dict."""
+    out = dict(legs)
+    roots = {k: armature.bones[chain[0]] for k, chain in legs.items()}
+    for k in ("LF", "RF"):
+        if k not in legs or len(legs[k]) >= 6:
+            continue
+        root = roots[k]
+        blade = root.parent
+        if blade is None:
+            continue
+        shared = any(
+            other is blade or blade in other.parent_recursive
+            for j, other in roots.items()
+            if j != k
+        )
+        head, joint = np.array(blade.head_local), np.array(root.head_local)
+        drop = float(head[2] - joint[2])
+        if shared or drop <= 0.25 * float(np.linalg.norm(joint - head)):
+            continue
+        out[k] = [blade.name] + legs[k]
+    return out
+
+
 def find_body(armature, legs):
     """The bone that carries root motion: the deepest common parent of every leg root,
     climbed up past connected bones (Blender ignores location keys on a connected bone)

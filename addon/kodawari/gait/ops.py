@@ -95,6 +95,7 @@ class KODAWARI_OT_gait_setup(bpy.types.Operator):
             )
         else:
             legs, how = rigmod.find_legs_by_name(armature), tip_("by name")
+        legs = rigmod.with_shoulders(armature, legs)
         missing = [k for k in LEG_NAMES if k not in legs]
         if missing:
             found = ", ".join(f"{k} ({len(v)} bones)" for k, v in legs.items()) or "none"

@@ -14,6 +14,7 @@ from .props import GAIT_NAMES, LEG_NAMES
 find_legs_by_name = legfinder.find_legs_by_name
 find_legs_from_feet = legfinder.find_legs_from_feet
 find_body = legfinder.find_body
+with_shoulders = legfinder.with_shoulders
 
 # The seed's joint ranges (4.x, degrees, each bone relative to its parent, the first
 # relative to straight down, positive swinging the tip backward), widened where the

@@ -644,7 +644,18 @@ class LegIk {
     auto rule = [&] { return planted_rule(start - 2, end + 2); };  // at the planted frames it touches
     const Real rule_before = std::max(rule(), Real(1));
     for (int k = 0; k < count; ++k) record(start + k, goals3[k], angles.data() + k * n_, errors[k]);
-    if (rule() <= rule_before) return true;
+    if (const Real evened = rule(); evened <= rule_before) {
+      if (evened <= 1) return true;
+      // Still over the rule: the lower exponent too, whichever breaks it less.
+      std::vector<Real> softer = old_angles, softer_errors = old_errors;
+      if (even_stance(chain_, goals.data(), count, solved_pose(start - 1), solved_pose(end), counted, softer,
+                      softer_errors, kIkTolerance, allowed, kEvenIterations, kEvenRetryExponent)) {
+        for (int k = 0; k < count; ++k) record(start + k, goals3[k], softer.data() + k * n_, softer_errors[k]);
+        if (rule() < evened) return true;
+        for (int k = 0; k < count; ++k) record(start + k, goals3[k], angles.data() + k * n_, errors[k]);
+      }
+      return true;
+    }
     // Broken at the lift-off only beside a slow first swing change: carried on into the swing.
     if (end > stance.last && lift_off_carries_on(i) && rule() <= rule_before) return true;
     for (int k = 0; k < count; ++k) record(start + k, goals3[k], angles.data() + k * n_, errors[k]);
