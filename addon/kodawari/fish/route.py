@@ -1,8 +1,9 @@
 """Fish Swim as a Geometry Nodes modifier (docs/algorithms.md §1.6).
 
 The live swim bends the fish inside Blender's own evaluation: a "Fish Swim" Geometry
-Nodes modifier, first in the stack, reads each vertex's bound FFD coordinates (three
-float attributes, bound once) and the current frame table (1024 segments x 8 vectors
+Nodes modifier, first in the stack, reads each vertex's bound FFD coordinates (float
+attributes, bound once; a coordinate the rest axis makes affine in the rest position is
+computed from Position instead, measured at bind time) and the current frame table (1024 segments x 8 vectors
 and the tail's frame, written per frame into a small helper mesh) and sets the bent
 positions with Sample Index nodes. Moving fins add a per-vertex offset the core computes per frame for the
 fin vertices only, written into a second helper mesh and read by an index attribute.
@@ -109,6 +110,13 @@ class _Tree:
         self.links.new(c, node.inputs[2])
         return node.outputs[0]
 
+    def affine(self, position, row):
+        """row[:3] . position + row[3]: a bound coordinate from the rest position."""
+        dot = self.node("ShaderNodeVectorMath", operation="DOT_PRODUCT")
+        self.links.new(position, dot.inputs[0])
+        dot.inputs[1].default_value = tuple(float(x) for x in row[:3])
+        return self.math("ADD", _enabled(dot.outputs), float(row[3]))
+
     def sample(self, geometry, attribute, index):
         node = self.node("GeometryNodeSampleIndex", data_type="FLOAT_VECTOR", domain="POINT")
         self.links.new(geometry, node.inputs["Geometry"])
@@ -122,18 +130,28 @@ class _Tree:
         return info.outputs["Geometry"]
 
 
-def build_group(table_obj, fins_obj, end_scale, with_keys=False, with_ends=True):
+def build_group(
+    table_obj, fins_obj, end_scale, with_keys=False, with_ends=True, rows=None, computed=None
+):
     """P' = (O + u e2 + v e3 + w e1) + f (dO + u de2 + v de3 + w de1) [+ fin offset], the
     core's deform_vertex (docs/algorithms.md §1.4, §1.6) in nodes. with_ends: some vertex
-    lies past an end of the axis (w != 0); without, the w terms are left out."""
+    lies past an end of the axis (w != 0); without, the w terms are left out. computed[k]:
+    coordinate k (of s, u, v) is rows[k][:3] . Position + rows[k][3] (the rest position:
+    never with the user's shape keys), not a stored attribute."""
+    computed = computed or (False, False, False)
     group = bpy.data.node_groups.new(GROUP, "GeometryNodeTree")
     group["kodawari_swim"] = 1
+    group["kodawari_stored"] = stored_letters(computed)
     _new_socket(group, "Geometry", "INPUT")
     _new_socket(group, "Geometry", "OUTPUT")
     tree = _Tree(group)
     group_in, group_out = tree.node("NodeGroupInput"), tree.node("NodeGroupOutput")
     table = tree.object_geometry("frames", table_obj)
-    s, u, v = (tree.named(name, "FLOAT") for name in COORDINATES)
+    position = tree.node("GeometryNodeInputPosition").outputs[0] if any(computed) else None
+    s, u, v = (
+        tree.affine(position, rows[k]) if computed[k] else tree.named(name, "FLOAT")
+        for k, name in enumerate(COORDINATES)
+    )
     t, w = s, None
     if with_ends:
         clamp = tree.node("ShaderNodeClamp")
@@ -187,7 +205,8 @@ def build_group(table_obj, fins_obj, end_scale, with_keys=False, with_ends=True)
     # The bound attributes stay on the user's mesh, not on what the swim hands on: Blender
     # 3.4 copies the mesh for Set Position (the attribute too, 12 bytes per vertex more
     # until the next frame), and exports and later modifiers have no use for them.
-    for name in (*COORDINATES, FIN_INDEX) if fins_obj is not None else COORDINATES:
+    stored = [name for name, c in zip(COORDINATES, computed) if not c]
+    for name in (*stored, FIN_INDEX) if fins_obj is not None else stored:
         remove = tree.node("GeometryNodeRemoveAttribute")
         remove.inputs["Name"].default_value = name
         tree.links.new(result, remove.inputs["Geometry"])
@@ -197,6 +216,17 @@ def build_group(table_obj, fins_obj, end_scale, with_keys=False, with_ends=True)
 
 
 # ----------------------------------------------------------------------------- set-up
+
+
+def stored_letters(computed):
+    """Which of s, u, v the route stores as attributes, as letters ("suv" before any was
+    computed: the node groups of older files carry no mark and store all three)."""
+    return "".join(letter for letter, c in zip("suv", computed) if not c)
+
+
+def stored_names(group):
+    letters = group.get("kodawari_stored", "suv")
+    return [name for letter, name in zip("suv", COORDINATES) if letter in letters]
 
 
 def has_ends(packed):
@@ -269,14 +299,21 @@ def install(obj, rig):
         _remove_helpers(mod)
     else:
         mod = obj.modifiers.new(MODIFIER, "NODES")
+    with_keys = mesh.shape_keys is not None
     packed = rig.packed_coordinates()
     with_ends = has_ends(packed)
+    # A coordinate the rest axis makes affine in the rest position (measured on every vertex
+    # at bind time, docs/algorithms.md §1.6) is computed from Position: no attribute. With
+    # the user's shape keys Position is not the rest position, so all three are stored.
+    computed = tuple(bool(h) and not with_keys for h in rig.affine_holds)
     for k, name in enumerate(COORDINATES):
-        _write_attribute(mesh, name, "FLOAT", np.ascontiguousarray(packed[:, k]))
+        if not computed[k]:
+            _write_attribute(mesh, name, "FLOAT", np.ascontiguousarray(packed[:, k]))
+        elif has_attribute(mesh, name):
+            mesh.attributes.remove(mesh.attributes[name])
     del packed
     if mesh.attributes.get(PACKED) is not None:
         mesh.attributes.remove(mesh.attributes[PACKED])
-    with_keys = mesh.shape_keys is not None
     rest_fields = tuple(REST + f for f in FIELDS) if with_keys else ()
     table_obj = _helper_object(TABLE, ROWS, FIELDS + rest_fields)
     if with_keys:
@@ -291,7 +328,9 @@ def install(obj, rig):
         fins_obj = _helper_object(FINS, len(rig.fin_vertices), (FIN_OFFSET,))
     elif mesh.attributes.get(FIN_INDEX) is not None:
         mesh.attributes.remove(mesh.attributes[FIN_INDEX])
-    mod.node_group = build_group(table_obj, fins_obj, rig.end_scale, with_keys, with_ends)
+    mod.node_group = build_group(
+        table_obj, fins_obj, rig.end_scale, with_keys, with_ends, rig.affine_rows, computed
+    )
     mod.node_group["kodawari_with_keys"] = with_keys
     # In Edit Mode the user edits the rest shape: show it, as the shape key used to.
     mod.show_in_editmode = False
@@ -322,7 +361,7 @@ def installed_for(obj, rig):
         return False
     mesh = obj.data
     return (
-        all(has_attribute(mesh, name) for name in COORDINATES)
+        all(has_attribute(mesh, name) for name in stored_names(mod.node_group))
         and (rig.fin_vertices is None) != has_attribute(mesh, FIN_INDEX)
         # shape keys added or removed since: the tree reads their offset, or not
         and bool(mod.node_group.get("kodawari_with_keys")) == (mesh.shape_keys is not None)
