@@ -5,6 +5,7 @@ the stack, its eye hides the swim, undo, save and reload); Remove Fish Swim leav
 exactly as it was; the mesh carries one 12-byte attribute per vertex, no shape keys."""
 
 import bpy
+import mathutils
 import numpy as np
 import pytest
 from fish_helpers import activate, add_swim, evaluated, make_fish, rest, set_fps, smooth_fish
@@ -322,6 +323,8 @@ def test_a_straight_axis_fish_stores_only_its_parameter(empty_scene):
     set_fps(24)
     obj = spindle_with_a_mouth()
     obj.scale = (0.01, 0.01, 0.01)  # modelled in centimetres
+    # ... away from its origin: u and v are offsets from an axis that does not pass through it
+    obj.data.transform(mathutils.Matrix.Translation((0.3, -0.2, 0.15)))
     activate(obj)
     assert bpy.ops.kodawari.swim_add(head_axis="POS_X", preset="CARANGIFORM", frequency=2.0) == {
         "FINISHED"
@@ -330,6 +333,10 @@ def test_a_straight_axis_fish_stores_only_its_parameter(empty_scene):
     assert moved > 0.02 and worst < 1e-5, worst
     assert _route_equals_full_binding(obj, (3, 8)) < 1e-5
     assert _stored(obj) == "s"
+    from kodawari.fish import route
+
+    offsets = route.modifier(obj).node_group["kodawari_offsets"]
+    assert np.abs(offsets) == pytest.approx((0.15, 0.2), abs=1e-6), "the axis's constants"
     shown = obj.evaluated_get(bpy.context.evaluated_depsgraph_get()).data
     assert not [a.name for a in shown.attributes if a.name.startswith(".kodawari")]
 

@@ -110,12 +110,13 @@ class _Tree:
         self.links.new(c, node.inputs[2])
         return node.outputs[0]
 
-    def affine(self, position, row):
-        """row[:3] . position + row[3]: a bound coordinate from the rest position."""
+    def affine(self, position, row, constant=True):
+        """row[:3] . position (+ row[3]): a bound coordinate from the rest position."""
         dot = self.node("ShaderNodeVectorMath", operation="DOT_PRODUCT")
         self.links.new(position, dot.inputs[0])
         dot.inputs[1].default_value = tuple(float(x) for x in row[:3])
-        return self.math("ADD", _enabled(dot.outputs), float(row[3]))
+        value = _enabled(dot.outputs)
+        return self.math("ADD", value, float(row[3])) if constant else value
 
     def sample(self, geometry, attribute, index):
         node = self.node("GeometryNodeSampleIndex", data_type="FLOAT_VECTOR", domain="POINT")
@@ -137,11 +138,13 @@ def build_group(
     core's deform_vertex (docs/algorithms.md §1.4, §1.6) in nodes. with_ends: some vertex
     lies past an end of the axis (w != 0); without, the w terms are left out. computed[k]:
     coordinate k (of s, u, v) is rows[k][:3] . Position + rows[k][3] (the rest position:
-    never with the user's shape keys), not a stored attribute."""
+    never with the user's shape keys), not a stored attribute; for u and v the constant
+    rows[k][3] rides in the frame table's origins instead (write_frame)."""
     computed = computed or (False, False, False)
     group = bpy.data.node_groups.new(GROUP, "GeometryNodeTree")
     group["kodawari_swim"] = 1
     group["kodawari_stored"] = stored_letters(computed)
+    group["kodawari_offsets"] = [float(rows[k][3]) if computed[k] else 0.0 for k in (1, 2)]
     _new_socket(group, "Geometry", "INPUT")
     _new_socket(group, "Geometry", "OUTPUT")
     tree = _Tree(group)
@@ -149,7 +152,9 @@ def build_group(
     table = tree.object_geometry("frames", table_obj)
     position = tree.node("GeometryNodeInputPosition").outputs[0] if any(computed) else None
     s, u, v = (
-        tree.affine(position, rows[k]) if computed[k] else tree.named(name, "FLOAT")
+        tree.affine(position, rows[k], constant=k == 0)
+        if computed[k]
+        else tree.named(name, "FLOAT")
         for k, name in enumerate(COORDINATES)
     )
     t, w = s, None
@@ -234,13 +239,19 @@ def has_ends(packed):
     return bool(np.any((packed[:, 0] < 0.0) | (packed[:, 0] > float(SEGMENTS))))
 
 
-def _rows(table, out):
+def _rows(table, out, offsets=(0.0, 0.0)):
     """The core's frame table (8 * 1024, 3) as the helper's rows (8, 1025, 3): each field's
-    1024 segments, then the tail's frame (value + change of the last segment, no change)."""
+    1024 segments, then the tail's frame (value + change of the last segment, no change).
+    offsets (c_u, c_v): the constants of u and v where the tree computes them from Position
+    as n . P alone; O + u e2 + v e3 = (O + c_u e2 + c_v e3) + (n_u . P) e2 + (n_v . P) e3, so
+    they are added to the origins (and their changes) here, once per row, not per vertex."""
     segments = table.reshape(len(FIELDS), SEGMENTS, 3)
     out[:, :SEGMENTS] = segments
     out[0::2, SEGMENTS] = segments[0::2, -1] + segments[1::2, -1]  # o, e1, e2, e3 at t = 1
     out[1::2, SEGMENTS] = 0.0
+    c_u, c_v = offsets
+    if c_u or c_v:
+        out[0:2] += np.float32(c_u) * out[4:6] + np.float32(c_v) * out[6:8]  # o, do from e2, e3
     return out
 
 
@@ -392,7 +403,8 @@ def write_frame(obj, table, fin_offsets):
     table_mesh, fins_mesh = helpers(obj)
     if table_mesh is None:
         return False
-    rows = _rows(table, _row_buffer)
+    offsets = modifier(obj).node_group.get("kodawari_offsets", (0.0, 0.0))
+    rows = _rows(table, _row_buffer, tuple(offsets))
     for k, name in enumerate(FIELDS):
         table_mesh.attributes[name].data.foreach_set("vector", rows[k].reshape(-1))
     table_mesh.update_tag()
