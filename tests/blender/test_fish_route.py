@@ -428,7 +428,9 @@ def test_a_file_bound_with_every_coordinate_stored_binds_again(empty_scene):
     assert np.array_equal(rest(obj), original)
 
 
-def test_apply_gives_what_the_core_gave_from_every_stored_coordinate(empty_scene):
+def test_bake_and_apply_give_what_the_core_gave_from_every_stored_coordinate(
+    empty_scene, tmp_path
+):
     # Bake and Apply deform in the core from the bound attributes and, for a coordinate the
     # route computes, the same affine row of the rest position: the shape is what a binding
     # holding every coordinate itself (as before) gives.
@@ -437,14 +439,30 @@ def test_apply_gives_what_the_core_gave_from_every_stored_coordinate(empty_scene
     settings = add_swim(obj, fins=("fin_pectoral",), head_axis="POS_X", preset="CETACEAN")
     scene = bpy.context.scene
     scene.frame_set(9)
+    from kodawari.fish import bake
     from kodawari.fish import rig as rig_module
-    from kodawari.fish import runtime, timing
+    from kodawari.fish import timing
 
     assert _stored(obj) == "su"
     whole = rig_module.SwimRig(obj, settings)  # a fresh binding, nothing released
     assert not whole.binding.released
-    phase, _ = timing.phase_and_distance(obj, settings, scene, 9, whole.body_length)
-    before = whole.evaluate(settings, phase).copy()
+
+    def as_before(frame):
+        phase, _ = timing.phase_and_distance(obj, settings, scene, frame, whole.body_length)
+        return whole.evaluate(settings, phase).copy()
+
+    cache = str(tmp_path / "dolphin.pc2")
+    activate(obj)
+    result = bpy.ops.kodawari.swim_bake(
+        frame_start=3, frame_end=5, target="MESH_CACHE", filepath=cache
+    )
+    assert result == {"FINISHED"}
+    _, _, baked = bake.read_pc2(cache)
+    for k, frame in enumerate((3, 4, 5)):
+        assert np.abs(baked[k] - as_before(frame)).max() < 1e-6 * whole.body_length, frame
+    assert bpy.ops.kodawari.swim_free_bake() == {"FINISHED"}
+    scene.frame_set(9)
+    before = as_before(9)
     shown = evaluated(obj).copy()
     activate(obj)
     assert bpy.ops.kodawari.swim_apply() == {"FINISHED"}
