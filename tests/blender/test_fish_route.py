@@ -428,9 +428,7 @@ def test_a_file_bound_with_every_coordinate_stored_binds_again(empty_scene):
     assert np.array_equal(rest(obj), original)
 
 
-def test_bake_and_apply_give_what_the_core_gave_from_every_stored_coordinate(
-    empty_scene, tmp_path
-):
+def test_bake_and_apply_give_what_the_core_gave_from_every_stored_coordinate(empty_scene, tmp_path):
     # Bake and Apply deform in the core from the bound attributes and, for a coordinate the
     # route computes, the same affine row of the rest position: the shape is what a binding
     # holding every coordinate itself (as before) gives.
@@ -439,9 +437,8 @@ def test_bake_and_apply_give_what_the_core_gave_from_every_stored_coordinate(
     settings = add_swim(obj, fins=("fin_pectoral",), head_axis="POS_X", preset="CETACEAN")
     scene = bpy.context.scene
     scene.frame_set(9)
-    from kodawari.fish import bake
+    from kodawari.fish import bake, timing
     from kodawari.fish import rig as rig_module
-    from kodawari.fish import timing
 
     assert _stored(obj) == "su"
     whole = rig_module.SwimRig(obj, settings)  # a fresh binding, nothing released
