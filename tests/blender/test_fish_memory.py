@@ -18,6 +18,7 @@ from fish_helpers import (
     rest,
     set_fps,
     smooth_fish,
+    spindle_with_a_mouth,
 )
 
 FINS = ("fin_dorsal", "fin_pectoral", "fin_caudal")
@@ -145,8 +146,6 @@ def test_a_straight_axis_fish_keeps_4_bytes_per_vertex_of_binding(empty_scene):
     # an affine function of it: the Fish Swim tree computes them from Position and the mesh
     # keeps only the parameter s, one float per vertex (12 bytes before; Blender 3.4 copies
     # the mesh's attributes into its evaluated mesh, so there 8 bytes instead of 24).
-    from test_fish_route import spindle_with_a_mouth
-
     set_fps(24)
     obj = spindle_with_a_mouth(segments=96, rings=64)
     before = {a.name for a in obj.data.attributes}

@@ -8,7 +8,16 @@ import bpy
 import mathutils
 import numpy as np
 import pytest
-from fish_helpers import activate, add_swim, evaluated, make_fish, rest, set_fps, smooth_fish
+from fish_helpers import (
+    activate,
+    add_swim,
+    evaluated,
+    make_fish,
+    rest,
+    set_fps,
+    smooth_fish,
+    spindle_with_a_mouth,
+)
 
 MODIFIER = "Fish Swim"
 
@@ -291,29 +300,6 @@ def test_a_file_saved_with_the_packed_float3_binding_swims_again(empty_scene):
     assert mesh.attributes.find(route.PACKED) < 0
     assert _stored(obj) == "su"  # v computed from the rest position (the tuna's axis is planar)
     assert np.array_equal(rest(obj), original)
-
-
-def spindle_with_a_mouth(name="spindle", segments=64, rings=48):
-    """A smooth body of revolution-like fish along +X (an ellipsoid 1 long, wider than high)
-    with a mouth slit pushed into its snout, the same above and below and on both sides:
-    its mid-line, and so its rest axis, is straight."""
-    import bmesh
-
-    mesh = bpy.data.meshes.new(name)
-    bm = bmesh.new()
-    bmesh.ops.create_uvsphere(bm, u_segments=segments, v_segments=rings, radius=1.0)
-    bm.to_mesh(mesh)
-    bm.free()
-    co = rest_of(mesh).astype(np.float64)
-    co = np.stack([co[:, 2] * 0.5, co[:, 1] * 0.08, -co[:, 0] * 0.1], axis=1)  # poles on X
-    mouth = (co[:, 0] > 0.46) & (np.abs(co[:, 2]) < 0.03)
-    co[mouth, 0] -= 0.05 * (1.0 - np.abs(co[mouth, 2]) / 0.03)  # the slit, deepest at its middle
-    mesh.vertices.foreach_set("co", co.astype(np.float32).reshape(-1))
-    mesh.polygons.foreach_set("use_smooth", np.ones(len(mesh.polygons), bool))
-    mesh.update()
-    obj = bpy.data.objects.new(name, mesh)
-    bpy.context.scene.collection.objects.link(obj)
-    return obj
 
 
 def test_a_straight_axis_fish_stores_only_its_parameter(empty_scene):
