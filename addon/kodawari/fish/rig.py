@@ -8,6 +8,7 @@ deform on its own vertices, carried by the body's rotation at the fin root.
 import hashlib
 
 import numpy as np
+from bpy.app.translations import pgettext_tip as tip_
 
 from .. import bulk, native
 from . import fins as fin_setup
@@ -196,7 +197,9 @@ class SwimRig:
                 out[:, k] = column
         if any(computed):
             if not all(h for h, c in zip(self.affine_holds, computed) if c):
-                raise ValueError("the swim's bound attributes are missing: add the Fish Swim again")
+                raise ValueError(
+                    tip_("the swim's bound attributes are missing: add the Fish Swim again")
+                )
             self.kn.ffd_fill_affine_coordinates(self.affine_rows, computed, self.rest, out)
         return out
 
