@@ -125,9 +125,10 @@ def measure(ring, rings):
     stored_obj = fish.copy()
     stored_obj.data = fish.data.copy()
     packed = rig.packed_coordinates()
-    # The helper's origins carry the constants of the fish's computed u and v (route._rows):
+    # The helper carries the constants and signs of the fish's computed u and v (route._rows):
     # stored without them, the copy shows the same shape from the same helper.
     packed[:, 1:] -= np.asarray(swim_group.get("kodawari_offsets", (0.0, 0.0)), np.float32)
+    packed[:, 1:] *= np.asarray(swim_group.get("kodawari_signs", (1.0, 1.0)), np.float32)
     for k, name in enumerate(route.COORDINATES):
         if stored_obj.data.attributes.find(name) < 0:
             attribute = stored_obj.data.attributes.new(name, "FLOAT", "POINT")

@@ -451,3 +451,36 @@ def test_bake_and_apply_give_what_the_core_gave_from_every_stored_coordinate(emp
     assert bpy.ops.kodawari.swim_apply() == {"FINISHED"}
     assert np.abs(rest(obj) - before).max() < 1e-6 * whole.body_length
     assert np.abs(shown - before).max() < 1e-5 * whole.body_length
+
+
+@pytest.mark.parametrize("head_axis", ["NEG_X", "POS_Y"])
+def test_a_computed_offset_along_a_negative_object_axis_is_exact(empty_scene, head_axis):
+    # Heading -X or +Y the side axis is an object axis turned over: the tree reads v as
+    # that axis's coordinate of Position and the table's e3 turns over instead (route._rows).
+    from kodawari.fish import route
+
+    set_fps(24)
+    obj = make_fish("tuna", head_axis=head_axis)
+    add_swim(obj, fins=("fin_pectoral",), head_axis=head_axis, frequency=2.0)
+    worst, moved = _route_equals_core(obj, (3, 7))
+    assert moved > 0.02 and worst < 1e-5, worst
+    assert _route_equals_full_binding(obj, (3, 7)) < 1e-5
+    assert _stored(obj) == "su"
+    assert list(route.modifier(obj).node_group["kodawari_signs"]) == [1.0, -1.0]
+
+
+def test_a_computed_offset_off_the_object_axes_reads_a_dot_product(empty_scene, monkeypatch):
+    # A row that is not an object axis (a rest axis modelled at a slant) is read as
+    # Dot Product(Position, n); the same shape.
+    from kodawari.fish import route
+
+    monkeypatch.setattr(route, "_object_axis", lambda row: None)
+    set_fps(24)
+    obj = make_fish("tuna", head_axis="NEG_X")
+    add_swim(obj, head_axis="NEG_X", frequency=2.0)
+    nodes = route.modifier(obj).node_group.nodes
+    assert any(n.type == "VECT_MATH" and n.operation == "DOT_PRODUCT" for n in nodes)
+    assert not any(n.type == "SEPXYZ" for n in nodes)
+    worst, moved = _route_equals_core(obj, (3, 7))
+    assert moved > 0.02 and worst < 1e-5, worst
+    assert _route_equals_full_binding(obj, (3, 7)) < 1e-5

@@ -145,18 +145,30 @@ def build_group(
     group["kodawari_swim"] = 1
     group["kodawari_stored"] = stored_letters(computed)
     group["kodawari_offsets"] = [float(rows[k][3]) if computed[k] else 0.0 for k in (1, 2)]
+    # A computed u or v whose row is an object axis (the set-up's head, up and side are)
+    # is that axis's coordinate of Position, from one Separate XYZ: cheaper than a Dot
+    # Product each; the row's sign rides in the table's e2 or e3 (write_frame).
+    axes = [_object_axis(rows[k]) if computed[k] else None for k in (1, 2)]
+    group["kodawari_signs"] = [axis[1] if axis else 1.0 for axis in axes]
     _new_socket(group, "Geometry", "INPUT")
     _new_socket(group, "Geometry", "OUTPUT")
     tree = _Tree(group)
     group_in, group_out = tree.node("NodeGroupInput"), tree.node("NodeGroupOutput")
     table = tree.object_geometry("frames", table_obj)
     position = tree.node("GeometryNodeInputPosition").outputs[0] if any(computed) else None
-    s, u, v = (
-        tree.affine(position, rows[k], constant=k == 0)
-        if computed[k]
-        else tree.named(name, "FLOAT")
-        for k, name in enumerate(COORDINATES)
-    )
+    separate = None
+    if any(axes):
+        separate = tree.node("ShaderNodeSeparateXYZ")
+        tree.links.new(position, separate.inputs[0])
+
+    def coordinate(k, name):
+        if not computed[k]:
+            return tree.named(name, "FLOAT")
+        if k > 0 and axes[k - 1]:
+            return separate.outputs[axes[k - 1][0]]
+        return tree.affine(position, rows[k], constant=k == 0)
+
+    s, u, v = (coordinate(k, name) for k, name in enumerate(COORDINATES))
     t, w = s, None
     if with_ends:
         clamp = tree.node("ShaderNodeClamp")
@@ -234,17 +246,28 @@ def stored_names(group):
     return [name for letter, name in zip("suv", COORDINATES) if letter in letters]
 
 
+def _object_axis(row):
+    """(index, sign) when row[:3] is exactly plus or minus one object axis, else None."""
+    normal = [float(x) for x in row[:3]]
+    for index, value in enumerate(normal):
+        if abs(value) == 1.0 and all(x == 0.0 for i, x in enumerate(normal) if i != index):
+            return index, value
+    return None
+
+
 def has_ends(packed):
     """Some vertex lies past an end of the axis (w != 0: s outside [0, 1024])."""
     return bool(np.any((packed[:, 0] < 0.0) | (packed[:, 0] > float(SEGMENTS))))
 
 
-def _rows(table, out, offsets=(0.0, 0.0)):
+def _rows(table, out, offsets=(0.0, 0.0), signs=(1.0, 1.0)):
     """The core's frame table (8 * 1024, 3) as the helper's rows (8, 1025, 3): each field's
     1024 segments, then the tail's frame (value + change of the last segment, no change).
     offsets (c_u, c_v): the constants of u and v where the tree computes them from Position
     as n . P alone; O + u e2 + v e3 = (O + c_u e2 + c_v e3) + (n_u . P) e2 + (n_v . P) e3, so
-    they are added to the origins (and their changes) here, once per row, not per vertex."""
+    they are added to the origins (and their changes) here, once per row, not per vertex.
+    signs: -1 where the tree reads u or v as an object axis's coordinate, the negative of
+    n . P: e2 or e3 (and its change) turn over instead."""
     segments = table.reshape(len(FIELDS), SEGMENTS, 3)
     out[:, :SEGMENTS] = segments
     out[0::2, SEGMENTS] = segments[0::2, -1] + segments[1::2, -1]  # o, e1, e2, e3 at t = 1
@@ -252,6 +275,9 @@ def _rows(table, out, offsets=(0.0, 0.0)):
     c_u, c_v = offsets
     if c_u or c_v:
         out[0:2] += np.float32(c_u) * out[4:6] + np.float32(c_v) * out[6:8]  # o, do from e2, e3
+    for sign, fields in zip(signs, (slice(4, 6), slice(6, 8))):
+        if sign < 0:
+            out[fields] *= np.float32(-1.0)
     return out
 
 
@@ -403,8 +429,9 @@ def write_frame(obj, table, fin_offsets):
     table_mesh, fins_mesh = helpers(obj)
     if table_mesh is None:
         return False
-    offsets = modifier(obj).node_group.get("kodawari_offsets", (0.0, 0.0))
-    rows = _rows(table, _row_buffer, tuple(offsets))
+    group = modifier(obj).node_group
+    offsets = group.get("kodawari_offsets", (0.0, 0.0))
+    rows = _rows(table, _row_buffer, tuple(offsets), tuple(group.get("kodawari_signs", (1.0, 1.0))))
     for k, name in enumerate(FIELDS):
         table_mesh.attributes[name].data.foreach_set("vector", rows[k].reshape(-1))
     table_mesh.update_tag()
