@@ -12,12 +12,13 @@ namespace kodawari::ffd {
 using AffineRow = std::array<float, 4>;
 
 struct AffineCoordinates {
-  std::array<AffineRow, 3> rows{};      // for s, u, v
-  std::array<bool, 3> holds{};          // the row gives that coordinate of every vertex within the bound
-  std::array<double, 3> worst{};        // its largest miss, in body lengths (s's segments scaled by L / 1024)
+  std::array<AffineRow, 3> rows{};  // for s, u, v
+  std::array<bool, 3> holds{};      // the row gives that coordinate of every vertex within the bound
+  std::array<double, 3> worst{};    // its largest miss, in body lengths (s's segments scaled by L / 1024)
 };
 
-// n . P + c in float, the order a Geometry Nodes dot product and add use.
+// n . P + c in float; the Fish Swim nodes compute the same up to float rounding (a Dot Product,
+// or one component of P for an object axis, with c folded into the frame table).
 inline float affine_value(const AffineRow& row, const float* p) {
   return (row[0] * p[0] + row[1] * p[1] + row[2] * p[2]) + row[3];
 }
