@@ -211,7 +211,24 @@ class PoseRotationView:
         if chanbase[1:] != (int(every[0]), int(every[-1])):
             return None
         names = (pose_bones[int(indices[0])].name, pose_bones[int(indices[-1])].name)
-        return cls(indices, offset, addresses, *chanbase, names, matrix_offset)
+        view = cls(indices, offset, addresses, *chanbase, names, matrix_offset)
+        # A few channels by name and address, for same_channels().
+        view.samples = [
+            (pose_bones[int(i)].name, int(every[i]))
+            for i in indices[np.linspace(0, len(indices) - 1, 5).astype(np.int64)]
+        ]
+        return view
+
+    def same_channels(self, pose):
+        """True when five of the view's bones (first, last and between, by name) are still at the
+        addresses the view was built on: a pose copied afresh (an evaluated copy, copied again
+        by Blender) could by chance get back its first and last channels' addresses, hardly all
+        five. A check for views of memory Blender replaces often, on top of current()."""
+        for name, address in self.samples:
+            pose_bone = pose.bones.get(name)
+            if pose_bone is None or pose_bone.as_pointer() != address:
+                return False
+        return True
 
     def current(self, pose):
         """False once the pose or its channel list changed (a bone added or removed)."""
@@ -236,6 +253,10 @@ class PoseRotationView:
     def write(self, rotations):
         """rotations (B, 4) float32 for every bone; the view's bones are written."""
         self.memory[self.index] = rotations[self.indices]
+
+    def write_rows(self, rows):
+        """rows (N, 4) float32, one a view's bone (rotations[indices], already gathered)."""
+        self.memory[self.index] = rows
 
     def read_matrices(self, rows):
         """The pose matrices of the view's bones at `rows` (indices into `indices`) as Blender's

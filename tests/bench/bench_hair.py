@@ -24,6 +24,12 @@ then the depsgraph evaluates whatever the frame handlers tagged.
                 itself cannot be installed on this machine), every chain bone's tail wiggling
   kodawari_cached  the same frames played again from the cache (scrubbing back): written
                 before Blender evaluates the frame (frame_change_pre), one evaluation
+  kodawari_paced, bare_paced  kodawari and bare as a user playing the animation feels them: each
+                frame requested at the scene's frame rate (frame_set, then a wait until the next
+                1/fps tick; a late frame asks for the next one at once), only the frame itself timed
+                (the main thread's work for it), the same way for both sides. Back to back, the
+                frame solved ahead has only Blender's evaluation to hide in; paced, it also has the
+                wait
   bare_retag    hair off, but a frame_change_post handler tags the armature as any write after
                 Blender's evaluation must: Blender's own price for changing a pose from Python
                 once it is evaluated (copy-on-write of the whole object + a second evaluation),
@@ -60,7 +66,15 @@ SIZES = {160: (10, 12, 6), 1_600: (100, 8, 3), 16_000: (1000, 8, 1)}
 ROUNDS = 5
 SIDES = ("kodawari", "bare", "wiggle2_port")  # each also measured for peak memory
 # timed only: their memory is kodawari's / bare's
-EXTRA_SIDES = ("kodawari_cached", "kodawari_inline", "kodawari_post", "bare_retag")
+EXTRA_SIDES = (
+    "kodawari_cached",
+    "kodawari_inline",
+    "kodawari_post",
+    "bare_retag",
+    "kodawari_paced",
+    "bare_paced",
+)
+PACED = ("kodawari_paced", "bare_paced")
 
 
 def build_rig(scene, chain_count):
@@ -133,6 +147,8 @@ class Sides:
     def use(self, side):
         from kodawari.hair import runtime
 
+        if side in PACED:
+            side = side.removesuffix("_paced")  # the same rig and path, only the requests paced
         self.obj.kodawari_hair.enabled = side in (
             "kodawari",
             "kodawari_cached",
@@ -165,6 +181,24 @@ class Sides:
         self.scene.frame_set(frame)
         self.scene.view_layers[0].depsgraph.update()
 
+    def paced(self, frames):
+        """Plays `frames` as playback requests them: one every 1/fps seconds of the scene's frame
+        rate (a frame that ends after its successor's tick has it requested at once); returns
+        each frame's own time (frame_set and the evaluation), not the wait."""
+        scene = self.scene
+        period = scene.render.fps_base / scene.render.fps
+        seconds = []
+        tick = time.perf_counter()
+        for frame in frames:
+            start = time.perf_counter()
+            self.frame(frame)
+            end = time.perf_counter()
+            seconds.append(end - start)
+            tick = max(tick + period, end)
+            while (left := tick - time.perf_counter()) > 0:
+                time.sleep(left)
+        return seconds
+
     def player(self, side, frames):
         def play(_round):
             self.use(side)
@@ -175,7 +209,9 @@ class Sides:
                 for frame in frames:  # simulated once (untimed); timing starts with a jump back
                     self.frame(frame)
             seconds = []
-            for frame in frames:
+            if side in PACED:
+                seconds = self.paced(frames)
+            for frame in frames if side not in PACED else ():
                 start = time.perf_counter()
                 self.frame(frame)
                 seconds.append(time.perf_counter() - start)
@@ -280,6 +316,7 @@ def measure_size(bones, chain_count, frames_ours, frames_port):
         "solved_ahead": ahead,
         "phases_ms": phases,
         "new_frames": len(frames["kodawari"]),
+        "fps": scene.render.fps / scene.render.fps_base,
     }
 
 
@@ -333,6 +370,9 @@ def breakdown(sides, frames):
     from kodawari.hair import runtime
 
     spent = dict.fromkeys((label for _, _, label in PHASES), 0.0)
+    # The main thread's processor time in each phase (time.thread_time): what our part of the
+    # frame costs that thread whatever else the machine runs (wall time adds waits for a core).
+    cpu = dict.fromkeys(spent, 0.0)
     sides.use("kodawari")  # first: it sets the runtime's methods the side uses
     sides.frame(1)  # the reset at the first frame is not a new frame's work
     originals = []
@@ -342,11 +382,12 @@ def breakdown(sides, frames):
         originals.append((target, name, original))
 
         def timed(*args, _original=original, _label=label, **kwargs):
-            start = time.perf_counter()
+            start, start_cpu = time.perf_counter(), time.thread_time()
             try:
                 return _original(*args, **kwargs)
             finally:
                 spent[_label] += time.perf_counter() - start
+                cpu[_label] += time.thread_time() - start_cpu
 
         setattr(target, name, timed)
     try:
@@ -362,6 +403,8 @@ def breakdown(sides, frames):
     out["Blender's pass (frame - handlers)"] = round(
         (total - spent["pre: all"] - spent["post: all"]) / len(frames) * 1e3, 2
     )
+    for label in ("pre: all", "post: all"):
+        out[f"{label}, main-thread CPU"] = round(cpu[label] / len(frames) * 1e3, 2)
     return out
 
 
@@ -404,7 +447,10 @@ def main():
                 "bare_retag",
             ):
                 ratio = f"  this / bare {row['ms_median'] / bare['ms_median']:5.2f}x"
-            elif side == "bare":
+            elif side == "kodawari_paced":
+                paced_bare = rows["bare_paced"]["ms_median"]
+                ratio = f"  this / bare_paced {row['ms_median'] / paced_bare:5.2f}x"
+            elif side in ("bare", "bare_paced"):
                 ratio = ""
             else:
                 ratio = f"  this / kodawari {row['ms_median'] / ours['ms_median']:7.1f}x"
@@ -437,6 +483,13 @@ def main():
             f"    kodawari predicted {predicted} of {size['new_frames']} new frames, {ahead} of them solved "
             f"ahead while Blender evaluated the frame before; kodawari / kodawari_inline "
             f"{ours['ms_median'] / rows['kodawari_inline']['ms_median']:.2f}x"
+        )
+        paced, paced_bare = rows["kodawari_paced"], rows["bare_paced"]
+        print(
+            f"    paced playback at {size['fps']:g} fps (each frame requested on the tick, the frame's own "
+            f"time): kodawari {paced['ms_median']:.2f} ms, bare {paced_bare['ms_median']:.2f} ms = "
+            f"{paced['ms_median'] / paced_bare['ms_median']:.2f}x (back to back "
+            f"{ours['ms_median'] / bare['ms_median']:.2f}x)"
         )
         print(
             "    where kodawari's new frame goes (ms, one more round): "

@@ -90,10 +90,11 @@ SESSION = (
 )
 
 
-def _play_session(head_by, ahead, max_caller_share=1.0):
+def _play_session(head_by, ahead, max_caller_share=1.0, evaluated_view=True, views_used=None):
     """Plays SESSION on a fresh rig, solving ahead or not; returns what every frame showed and,
     per frame set, the frames that took the result solved ahead (a jump or a rebuilt runtime
-    replays several)."""
+    replays several). Without evaluated_view the evaluated copy is written and read through RNA;
+    views_used gets how often its memory was (runtime._evaluated_view)."""
     from kodawari.hair import runtime
 
     bpy.ops.wm.read_homefile(use_empty=True, use_factory_startup=True)
@@ -110,6 +111,15 @@ def _play_session(head_by, ahead, max_caller_share=1.0):
         return used
 
     runtime.ArmatureRuntime._take_ahead = spy
+    views = runtime.ArmatureRuntime._evaluated_view
+    used = []
+
+    def spy_view(self, *args):
+        view = views(self, *args) if evaluated_view else None
+        used.append(view is not None)
+        return view
+
+    runtime.ArmatureRuntime._evaluated_view = spy_view
     min_bones, max_share = runtime.AHEAD_MIN_ROD_BONES, runtime.AHEAD_MAX_CALLER_SHARE
     runtime.AHEAD_MIN_ROD_BONES = 0  # this small rig solved ahead as a large one is
     # Never paused for a busy machine (a timing rule), unless the test asks for it.
@@ -128,7 +138,10 @@ def _play_session(head_by, ahead, max_caller_share=1.0):
     finally:
         runtime.ArmatureRuntime._take_ahead = take
         runtime.ArmatureRuntime._start_ahead = start
+        runtime.ArmatureRuntime._evaluated_view = views
         runtime.AHEAD_MIN_ROD_BONES, runtime.AHEAD_MAX_CALLER_SHARE = min_bones, max_share
+    if views_used is not None:
+        views_used.append(sum(used))
     return seen, taken_per_set
 
 
@@ -170,3 +183,33 @@ def test_frames_solved_in_place_while_the_step_ahead_pauses_show_the_same_poses(
     _assert_same(seen, plain)
     assert taken[3] == [3], "the first frame after the start takes the one solved ahead"
     assert not any(taken[f] for f in range(4, 9)), "then 24 frames are solved in place"
+
+
+def test_rotations_written_in_the_evaluated_copys_memory_show_the_rna_paths_poses(empty_scene):
+    """The rod bones' rotations are written into (and checked in) the viewport's evaluated copy
+    in its own memory, not through a foreach_set / foreach_get over every bone (runtime.
+    _evaluated_view): every frame of the session, whatever happens between frames (a rebuilt
+    runtime, a tag that has Blender copy the armature afresh), shows bit for bit what RNA shows."""
+    used = []
+    through_rna, _ = _play_session("action", ahead=True, evaluated_view=False, views_used=used)
+    seen, _ = _play_session("action", ahead=True, views_used=used)
+    _assert_same(seen, through_rna)
+    assert used[0] == 0 and used[1] > len(SESSION), f"the copy's memory used {used[1]} times"
+
+
+def test_a_rig_whose_few_input_bones_are_read_one_by_one_shows_the_same_poses(empty_scene):
+    """Large rigs read their few input and other bones one by one (runtime.SPARSE_READ_RATIO:
+    16,000 rod bones under a head), and then keep the predicted rotations through the check
+    after the pass without restoring them: the session, solved ahead or not, shows bit for bit
+    the poses of this small rig read in bulk."""
+    from kodawari.hair import runtime
+
+    plain, _ = _play_session("action", ahead=False)
+    ratio = runtime.SPARSE_READ_RATIO
+    runtime.SPARSE_READ_RATIO = 1  # every bone but the rods' is "few"
+    try:
+        for ahead in (False, True):
+            seen, _ = _play_session("action", ahead=ahead)
+            _assert_same(seen, plain)
+    finally:
+        runtime.SPARSE_READ_RATIO = ratio

@@ -176,3 +176,35 @@ def test_a_step_started_again_drops_the_earlier_one_and_gives_the_new_inputs_ste
     played.step(rotations_out=out, **_inputs(3))
     np.testing.assert_array_equal(ahead_out, out)
     np.testing.assert_array_equal(ahead_system.save_state(), played.save_state())
+
+
+def test_a_state_changed_while_the_thread_copies_it_waits_and_each_side_steps_the_right_state():
+    """The twin's copy of the state is made on the thread, off the caller's frame: a change of
+    the system made right after start() (a frame solved in place, a recalled frame) waits for that
+    copy, so the step ahead and the system's own step each start from the state they should."""
+    played, out = _started()
+    system, system_out = _started()
+    ahead = kn.RodStepAhead()
+    ahead.start(
+        system, **_inputs(3)
+    )  # the first start makes the twin; later ones copy on the thread
+    assert ahead.finish(system_out) and ahead.adopt(system)
+    played.step(rotations_out=out, **_inputs(3))
+    for frame in range(4, 12):
+        reference = played.save_state()
+        ahead.start(system, **_inputs(frame))
+        system.step(rotations_out=system_out, **_inputs(frame + 7))  # at once: the copy in flight
+        ahead_out = np.zeros((BONE_COUNT, 4), np.float32)
+        assert ahead.finish(ahead_out)
+        assert not ahead.adopt(system), "the state moved on after the start"
+        played.step(rotations_out=out, **_inputs(frame))
+        np.testing.assert_array_equal(ahead_out[2:], out[2:], err_msg=f"frame {frame} ahead")
+        jumped, jumped_out = _started()  # frame + 7's step from the same state, elsewhere
+        jumped.load_state(reference)
+        jumped.step(rotations_out=jumped_out, **_inputs(frame + 7))
+        np.testing.assert_array_equal(system_out[2:], jumped_out[2:], err_msg=f"frame {frame}")
+        np.testing.assert_array_equal(system.save_state(), jumped.save_state())
+        system.load_state(played.save_state())  # back in step with the played system
+    ahead.start(system, **_inputs(12))
+    del system  # a system dropped while the thread copies it waits for the copy (no crash)
+    assert ahead.finish(np.zeros((BONE_COUNT, 4), np.float32))

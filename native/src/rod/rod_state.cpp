@@ -149,6 +149,7 @@ void RodSystem::write_state(Real* out) const {
 }
 
 void RodSystem::read_state(const Real* in) {
+  settle();
   ++state_revision_;
   for (std::size_t r = 0; r < rods_.size(); ++r) {
     read_rod_state(r, in);

@@ -43,12 +43,15 @@ void RodStepAhead::start(const RodSystem& system, const FrameInput& input, const
   snapshot_made_ = false;
   snapshot_wanted_ = rotations != nullptr;
   if (snapshot_wanted_) snapshot_rotations_.assign(rotations, rotations + 4 * system.bone_count());
+  // A new twin is made here (rods and colliders changed: rare); the state of an existing one is
+  // copied by the thread, off the caller's frame, the system pinned until it is (pin_state).
+  bool copy_state = false;
   if (!twin_ || source_ != &system || definition_ != system.definition_revision()) {
     twin_ = system.twin(threads_);
     source_ = &system;
     definition_ = system.definition_revision();
   } else {
-    twin_->copy_state_from(system);
+    copy_state = true;
   }
   state_ = system.state_revision();
   const std::size_t bones = system.bone_count();
@@ -58,9 +61,28 @@ void RodStepAhead::start(const RodSystem& system, const FrameInput& input, const
   input_.bone_matrices = matrices_.data();
   chunks_ = (twin_->rod_count() + detail::kRodsPerChunk - 1) / detail::kRodsPerChunk;
   next_chunk_ = 0;
-  worker_ = std::thread([this] {
+  if (copy_state) system.pin_state();
+  try {
+    launch(copy_state);
+  } catch (...) {  // no thread: nothing copies, nothing steps (started() stays false)
+    if (copy_state) system.unpin_state();
+    throw;
+  }
+}
+
+void RodStepAhead::launch(bool copy_state) {
+  worker_ = std::thread([this, copy_state] {
+    bool copied = true;
+    if (copy_state) {
+      try {
+        twin_->copy_state_from(*source_);  // same sizes: no allocation
+      } catch (...) {  // not expected (a twin of the same rods); no result then
+        copied = false;
+      }
+      source_->unpin_state();
+    }
     try {
-      if (snapshot_wanted_) {
+      if (snapshot_wanted_ && copied) {
         FrameCache::Entry entry = twin_->snapshot(snapshot_rotations_.data());
         std::lock_guard<std::mutex> lock(mutex_);
         snapshot_ = std::move(entry);
@@ -72,9 +94,9 @@ void RodStepAhead::start(const RodSystem& system, const FrameInput& input, const
       snapshot_made_ = true;
     }
     made_.notify_all();
-    bool ready = true;
+    bool ready = copied;
     try {
-      colliders_ = twin_->begin_step(input_);
+      if (ready) colliders_ = twin_->begin_step(input_);
     } catch (...) {  // an allocation failure: no result; the caller steps the system itself
       ready = false;
     }

@@ -41,7 +41,29 @@ void bone_transform(const float* bone_matrices, std::size_t index, Quat& rotatio
 
 RodSystem::RodSystem(std::size_t bone_count, unsigned threads) : bone_count_(bone_count), threads_(threads) {}
 
+RodSystem::~RodSystem() { settle(); }
+
+void RodSystem::pin_state() const {
+  std::lock_guard<std::mutex> lock(pin_->mutex);
+  ++pin_->copies;
+}
+
+void RodSystem::unpin_state() const {
+  {
+    std::lock_guard<std::mutex> lock(pin_->mutex);
+    --pin_->copies;
+  }
+  pin_->released.notify_all();
+}
+
+void RodSystem::settle() const {
+  if (!pin_) return;  // moved from
+  std::unique_lock<std::mutex> lock(pin_->mutex);
+  pin_->released.wait(lock, [this] { return pin_->copies == 0; });
+}
+
 std::size_t RodSystem::add_rod(RodDefinition rod) {
+  settle();
   const std::size_t n = rod.bones.size();
   auto fail = [](const std::string& why) { throw std::invalid_argument(why); };
   if (n == 0) fail("a rod needs at least one joint (got 0 bones)");
@@ -98,6 +120,7 @@ std::size_t RodSystem::add_rod(RodDefinition rod) {
 }
 
 void RodSystem::set_colliders(std::vector<ColliderDefinition> colliders) {
+  settle();
   for (const auto& c : colliders) {
     if (c.bone < 0 || static_cast<std::size_t>(c.bone) >= bone_count_) {
       throw std::invalid_argument("a collider bone index is outside the armature");
@@ -148,6 +171,7 @@ void RodSystem::write_output(std::size_t r, float* rotations_out) {
 }
 
 void RodSystem::reset(const FrameInput& input, float* rotations_out) {
+  settle();
   ++state_revision_;
   const std::vector<Collider> colliders = world_colliders(input);
   parallel_chunks(rods_.size(), threads_, kRodsPerChunk, [&](std::size_t begin, std::size_t end) {
@@ -159,6 +183,7 @@ void RodSystem::reset(const FrameInput& input, float* rotations_out) {
 }
 
 std::vector<Collider> RodSystem::begin_step(const FrameInput& input) {
+  settle();
   ++state_revision_;
   return world_colliders(input);
 }
@@ -206,6 +231,7 @@ void RodSystem::copy_state_from(const RodSystem& twin) {
   if (twin.rods_.size() != rods_.size() || twin.bone_count_ != bone_count_) {
     throw std::invalid_argument("copy_state_from: not a twin of this system");
   }
+  settle();
   states_ = twin.states_;  // same sizes: the vectors keep their memory, no allocation
   weights_ = twin.weights_;
   ++state_revision_;
@@ -215,6 +241,8 @@ void RodSystem::swap_state(RodSystem& twin) {
   if (twin.rods_.size() != rods_.size() || twin.bone_count_ != bone_count_) {
     throw std::invalid_argument("swap_state: not a twin of this system");
   }
+  settle();
+  twin.settle();
   states_.swap(twin.states_);
   weights_.swap(twin.weights_);
   ++state_revision_;

@@ -1,9 +1,11 @@
 // The next frame of a RodSystem, stepped on a worker thread while the caller does other work
 // (docs/algorithms.md §3.7: the hair's next frame is solved while Blender evaluates this one).
 //
-// start() copies the system's state into a twin (same rods, same colliders, no cache) and steps
-// the twin by the given input on its own thread; the system itself is not touched, so it can be
-// read, cached and stepped meanwhile. Before stepping, the thread makes the frame-cache snapshot
+// start() has the system's state copied into a twin (same rods, same colliders, no cache) and the
+// twin stepped by the given input on its own thread; the copy is the thread's first work (off the
+// caller's frame: the system is pinned until it is made, so a change of its state meanwhile waits
+// for it, RodSystem::pin_state), and the system itself is not touched, so it can be read, cached
+// and stepped meanwhile. Before stepping, the thread makes the frame-cache snapshot
 // of the state it started from (what system.store_frame() would make of it), which store() puts
 // into the system's cache: the caller's frame is then cached without the copy. The rods are taken
 // in chunks from one counter by the thread (with more than one thread, by the process's kept
@@ -34,9 +36,9 @@ class RodStepAhead {
   RodStepAhead(const RodStepAhead&) = delete;
   RodStepAhead& operator=(const RodStepAhead&) = delete;
 
-  // Drops an earlier step (the chunks nobody took are skipped), copies `system`'s state (its
-  // rods and colliders too when they changed) and `input` (the bone matrices included), and
-  // starts the step. Returns at once. With `rotations` (bone_count x 4, the rotations the
+  // Drops an earlier step (the chunks nobody took are skipped), copies `input` (the bone matrices
+  // included; the rods and colliders too when they changed) and starts the thread, which copies
+  // `system`'s state first. Returns at once. With `rotations` (bone_count x 4, the rotations the
   // system's state was written with), the thread first makes the snapshot for store().
   void start(const RodSystem& system, const FrameInput& input, const float* rotations = nullptr);
   // Caches the snapshot as `frame` in `system` when it is the system the step started from and
@@ -58,6 +60,7 @@ class RodStepAhead {
   std::size_t bone_count() const { return twin_ ? twin_->bone_count() : 0; }
 
  private:
+  void launch(bool copy_state);  // the thread: copy the state (if asked), snapshot, step
   void wait();
   void cancel();  // stops handing out chunks of a running step and waits for the thread
   bool same_state(const RodSystem& system) const;

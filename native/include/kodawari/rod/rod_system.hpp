@@ -18,8 +18,10 @@
 // jump (camera cut) adds no velocity: the chain is not flung.
 #pragma once
 
+#include <condition_variable>
 #include <cstdint>
 #include <memory>
+#include <mutex>
 #include <string>
 #include <vector>
 
@@ -133,6 +135,9 @@ struct RodEnergy {
 class RodSystem {
  public:
   explicit RodSystem(std::size_t bone_count, unsigned threads = 0);
+  ~RodSystem();  // waits for a copy of its state in flight (pin_state)
+  RodSystem(RodSystem&&) noexcept = default;
+  RodSystem& operator=(RodSystem&&) noexcept = default;
 
   // Validates and adds a rod; returns its index. Throws std::invalid_argument.
   std::size_t add_rod(RodDefinition rod);
@@ -193,8 +198,15 @@ class RodSystem {
   // The simulation state of a twin copied into this system, or exchanged with it (no copy).
   void copy_state_from(const RodSystem& twin);
   void swap_state(RodSystem& twin);
+  // A copy of this state made on another thread (RodStepAhead copies it into its twin there, off
+  // the caller's frame): pin_state() before handing the copy over, unpin_state() by the thread
+  // once copied. Meanwhile const reads go on; every change of state (anything that moves the
+  // state revision, and a change of rods or colliders) waits for the copy to end.
+  void pin_state() const;
+  void unpin_state() const;
 
  private:
+  void settle() const;  // waits until no pinned copy is in flight
   void begin_frame(std::size_t r, const FrameInput& input, const std::vector<Collider>& colliders, bool reset);
   void simulate(std::size_t r, const FrameInput& input, const std::vector<Collider>& colliders);
   void write_output(std::size_t r, float* rotations_out);
@@ -214,6 +226,12 @@ class RodSystem {
   FrameCache cache_;
   std::uint64_t state_revision_ = 0;
   std::uint64_t definition_revision_ = 0;
+  struct StatePin {
+    std::mutex mutex;
+    std::condition_variable released;
+    int copies = 0;
+  };
+  std::unique_ptr<StatePin> pin_ = std::make_unique<StatePin>();  // unique_ptr: the system stays movable
 };
 
 // Matrix of pose bone `index` from the foreach_get buffer, with rotation and position.
