@@ -127,7 +127,8 @@ def fish_table(runs, out):
     out.append("")
     out.append(
         "Kodawari = live handler (control axis, frame table into the Fish Swim modifier's helper), then "
-        "Blender's evaluation of the Fish Swim Geometry Nodes modifier (bound attribute, Sample Index). "
+        "Blender's evaluation of the Fish Swim Geometry Nodes modifier (the bound parameter s as an attribute; "
+        "u and v, affine in the rest position on this body's straight axis, computed from Position; Sample Index). "
         "Geometry Nodes = Sample Curve → Set Position along the same animated curve (the fish's own control "
         "axis, keyed per frame). Curve modifier = the same curve. Floor = the same mesh whose only change is "
         "an animated shape-key value. Ratios use the medians; memory ratios the peak above start."

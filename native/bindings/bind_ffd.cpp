@@ -51,6 +51,16 @@ py::array_t<float> coordinate_column(const AxisBinding& binding, Field field) {
   return out;
 }
 
+py::tuple affine_to_python(const ffd::AffineCoordinates& affine) {
+  py::array_t<float> rows({py::ssize_t(3), py::ssize_t(4)});
+  float* data = rows.mutable_data();
+  for (int k = 0; k < 3; ++k) {
+    for (int j = 0; j < 4; ++j) data[4 * k + j] = affine.rows[k][j];
+  }
+  return py::make_tuple(rows, py::make_tuple(affine.holds[0], affine.holds[1], affine.holds[2]),
+                        py::make_tuple(affine.worst[0], affine.worst[1], affine.worst[2]));
+}
+
 }  // namespace
 
 void bind_ffd(py::module_& m) {
@@ -133,6 +143,23 @@ void bind_ffd(py::module_& m) {
           py::arg("end_scale"),
           "float32 (N, 3): (s, u, v) per vertex, s = segment + fraction, or beyond an end w * end_scale "
           "(head) / 1024 + w * end_scale (tail).")
+      .def(
+          "affine_coordinates",
+          [](const AxisBinding& b, const py::handle& vertices, double end_scale, double tolerance) {
+            if (!(end_scale > 0) || !std::isfinite(end_scale)) throw py::value_error("end_scale must be > 0");
+            if (!(tolerance >= 0) || !std::isfinite(tolerance)) throw py::value_error("tolerance must be >= 0");
+            const auto verts = checked_array<float>(vertices, "vertices", static_cast<py::ssize_t>(b.count()), 3);
+            ffd::AffineCoordinates affine;
+            {
+              py::gil_scoped_release release;
+              affine = b.affine_coordinates(verts.data(), b.count(), static_cast<float>(end_scale), tolerance);
+            }
+            return affine_to_python(affine);
+          },
+          py::arg("vertices"), py::arg("end_scale"), py::arg("tolerance"),
+          "(rows float32 (3, 4), holds (3 bools), worst (3 floats)): which packed coordinates (s, u, v) "
+          "are n . P + c of the bound rest positions `vertices` within `tolerance` body lengths "
+          "(docs/algorithms.md §1.6); row k is (n, c).")
       .def("release_coordinates", &AxisBinding::release_coordinates,
            "Free the per-vertex coordinates (kept in a packed attribute instead); frame_table still works.")
       .def_property_readonly("released", &AxisBinding::released);
@@ -180,6 +207,30 @@ void bind_ffd(py::module_& m) {
       py::arg("table"), py::arg("packed"), py::arg("end_scale"), py::arg("out"),
       "Deform packed (s, u, v) coordinates (float32 (N, 3)) by a frame table (float32 (8 * 1024, 3), "
       "AxisBinding.frame_table) into out (float32 (N, 3)): what the Fish Swim modifier computes.");
+
+  m.def(
+      "ffd_fill_affine_coordinates",
+      [](const py::handle& rows, const py::sequence& holds, const py::handle& vertices, const py::handle& packed) {
+        const auto row_array = checked_array<float>(rows, "rows", 3, 4);
+        if (py::len(holds) != 3) throw py::value_error("holds must have 3 values (s, u, v)");
+        const auto verts = checked_array<float>(vertices, "vertices", -1, 3);
+        auto target = checked_output<float>(packed, "packed", verts.shape(0), 3);
+        no_overlap(target, "packed", verts, "vertices");
+        ffd::AffineCoordinates affine;
+        for (int k = 0; k < 3; ++k) {
+          affine.holds[k] = py::cast<bool>(holds[k]);
+          for (int j = 0; j < 4; ++j) affine.rows[k][j] = row_array.data()[4 * k + j];
+        }
+        float* data = target.mutable_data();
+        {
+          py::gil_scoped_release release;
+          ffd::fill_affine_coordinates(affine, verts.data(), static_cast<std::size_t>(verts.shape(0)), data);
+        }
+      },
+      py::arg("rows"), py::arg("holds"), py::arg("vertices"), py::arg("packed"),
+      "Write each packed coordinate k whose holds[k] is true as rows[k] . (P, 1) of the rest positions "
+      "`vertices` (float32 (N, 3)) into column k of `packed` (float32 (N, 3)); what the Fish Swim "
+      "modifier computes from Position instead of a stored attribute.");
 
   m.def(
       "ffd_bind",

@@ -7,8 +7,9 @@ whatever is tagged, then the evaluated mesh's vertex normals are read (a viewpor
 
   kodawari        the add-on's live swim: the frame handler writes the frame table (1024
                   segments) into the Fish Swim modifier's helper; Blender's evaluation bends
-                  the mesh in that Geometry Nodes modifier from the bound (s, u, v) attribute
-                  (docs/algorithms.md §1.6)
+                  the mesh in that Geometry Nodes modifier from the bound (s, u, v) (this body's
+                  rest axis is straight: s an attribute, u and v computed from Position;
+                  docs/algorithms.md §1.6)
   geometry_nodes  a Geometry Nodes bend of the same mesh along the same animated curve:
                   Sample Curve (factor = position along the body) -> Set Position
                   (curve point + normal * y + binormal * z), built here through the node API
@@ -331,7 +332,7 @@ def solver_alone(obj, scene, frames):
 
     rig = runtime.get_rig(obj)
     out = np.empty((rig.count, 3), np.float32)
-    packed = rig.packed_coordinates()  # the bound attribute, read once
+    packed = rig.packed_coordinates()  # the bound coordinates, read (or computed) once
     evaluate, deform = [], []
     for _ in range(benchlib.ROUNDS):
         evaluate.append(

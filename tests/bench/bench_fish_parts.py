@@ -10,7 +10,10 @@ wall time), the parts interleaved round by round as in every benchmark here:
                   modifier (a tree that passes the mesh through, still depending on the helper)
   set_position    the Fish Swim tree cut down to Set Position from one bound attribute
   first_sample    ... plus Floor and one Sample Index on the helper
-  fish_swim       the whole Fish Swim tree, as it plays (docs/algorithms.md §1.6)
+  fish_swim       the whole Fish Swim tree, as it plays (docs/algorithms.md §1.6): this body's
+                  rest axis is straight, so u and v are computed from Position, s is read
+  stored_suv      the same tree reading all three of (s, u, v) from attributes (what a fish whose
+                  rest axis curves gets, and every fish before), on a copy carrying them
   + normals       the same frame with the evaluated vertex normals read (as a viewport does)
   geometry_nodes  the Geometry Nodes bend's frame of bench_fish.py (its curve's animation and
                   its tree), no normals read
@@ -22,6 +25,7 @@ import sys
 import time
 
 import bpy
+import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import bench_fish
@@ -117,6 +121,27 @@ def measure(ring, rings):
         part_scene.frame_set(1)  # makes the scene's depsgraph
         parts[part] = (part_scene, obj)
 
+    # The whole tree as it was before u and v could be computed: all three read.
+    stored_obj = fish.copy()
+    stored_obj.data = fish.data.copy()
+    packed = rig.packed_coordinates()
+    # The helper carries the constants and signs of the fish's computed u and v (route._rows):
+    # stored without them, the copy shows the same shape from the same helper.
+    packed[:, 1:] -= np.asarray(swim_group.get("kodawari_offsets", (0.0, 0.0)), np.float32)
+    packed[:, 1:] *= np.asarray(swim_group.get("kodawari_signs", (1.0, 1.0)), np.float32)
+    for k, name in enumerate(route.COORDINATES):
+        if stored_obj.data.attributes.find(name) < 0:
+            attribute = stored_obj.data.attributes.new(name, "FLOAT", "POINT")
+            attribute.data.foreach_set("value", packed[:, k].copy())
+    route.modifier(stored_obj).node_group = route.build_group(
+        table_obj, None, rig.end_scale, with_ends=route.has_ends(packed)
+    )
+    del packed
+    stored_scene = bench_fish.new_scene("stored_suv")
+    stored_scene.collection.objects.link(stored_obj)
+    stored_scene.frame_set(1)
+    parts["stored_suv"] = (stored_scene, stored_obj)
+
     def tree_frame(part, normals=False):
         part_scene, obj = parts[part]
         depsgraph = part_scene.view_layers[0].depsgraph
@@ -140,7 +165,7 @@ def measure(ring, rings):
         return once
 
     plays = {"handler": cpu_per_frame(lambda f: runtime.evaluate(fish, scene, f))}
-    plays.update({part: cpu_per_frame(tree_frame(part)) for part in TREE_PARTS})
+    plays.update({part: cpu_per_frame(tree_frame(part)) for part in (*TREE_PARTS, "stored_suv")})
     plays["+ normals"] = cpu_per_frame(tree_frame("fish_swim", normals=True))
     plays.update({side: cpu_per_frame(other_frame(side)) for side in others})
     rows = benchlib.Rounds(rounds=5).run(plays)
@@ -165,6 +190,10 @@ def main():
             f"    normals read: {normals:.2f} ms of the swim's {whole:.2f} ms frame;"
             f" the tree beyond the floor's shape-key mix:"
             f" {rows['fish_swim']['ms_median'] - rows['floor']['ms_median']:.2f} ms"
+        )
+        print(
+            f"    u, v from Position instead of attributes: the tree"
+            f" {rows['fish_swim']['ms_median'] / rows['stored_suv']['ms_median']:.2f}x"
         )
         results.append({"vertices": count, "rows": rows})
     benchlib.record("fish_parts", results)

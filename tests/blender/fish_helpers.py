@@ -3,7 +3,10 @@
 import os
 import sys
 
-import bpy
+import bpy  # first: puts Blender's own modules (bmesh) on sys.path
+
+# isort: split
+import bmesh
 import numpy as np
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
@@ -103,3 +106,26 @@ def set_fps(fps=24):
     scene.render.fps = fps
     scene.render.fps_base = 1.0
     scene.frame_start = 1
+
+
+def spindle_with_a_mouth(name="spindle", segments=64, rings=48):
+    """A smooth body of revolution-like fish along +X (an ellipsoid 1 long, wider than high)
+    with a mouth slit pushed into its snout, the same above and below and on both sides:
+    its mid-line, and so its rest axis, is straight."""
+    mesh = bpy.data.meshes.new(name)
+    bm = bmesh.new()
+    bmesh.ops.create_uvsphere(bm, u_segments=segments, v_segments=rings, radius=1.0)
+    bm.to_mesh(mesh)
+    bm.free()
+    co = np.empty((len(mesh.vertices), 3), dtype=np.float32)
+    mesh.vertices.foreach_get("co", co.reshape(-1))
+    co = co.astype(np.float64)
+    co = np.stack([co[:, 2] * 0.5, co[:, 1] * 0.08, -co[:, 0] * 0.1], axis=1)  # poles on X
+    mouth = (co[:, 0] > 0.46) & (np.abs(co[:, 2]) < 0.03)
+    co[mouth, 0] -= 0.05 * (1.0 - np.abs(co[mouth, 2]) / 0.03)  # the slit, deepest at its middle
+    mesh.vertices.foreach_set("co", co.astype(np.float32).reshape(-1))
+    mesh.polygons.foreach_set("use_smooth", np.ones(len(mesh.polygons), bool))
+    mesh.update()
+    obj = bpy.data.objects.new(name, mesh)
+    bpy.context.scene.collection.objects.link(obj)
+    return obj

@@ -18,6 +18,7 @@ from fish_helpers import (
     rest,
     set_fps,
     smooth_fish,
+    spindle_with_a_mouth,
 )
 
 FINS = ("fin_dorsal", "fin_pectoral", "fin_caudal")
@@ -62,7 +63,7 @@ def test_the_frame_written_is_the_deformation_and_the_mesh_is_untouched(empty_sc
     # Per frame only the helpers change: the user's mesh keeps its positions and attributes.
     assert np.array_equal(rest(obj), mesh_before)
     assert sorted(obj.data.attributes.keys()) == names_before
-    assert set(route.COORDINATES) <= set(names_before) and obj.data.shape_keys is None
+    assert set(route.COORDINATES[:2]) <= set(names_before) and obj.data.shape_keys is None
 
 
 def test_add_fish_swim_binds_the_mesh_once(empty_scene, monkeypatch):
@@ -138,3 +139,24 @@ def test_playing_keeps_one_copy_of_the_fish_bound_data(empty_scene):
     shared = _blender_memory_mb()
     extra = (playing - shared) * 2**20 / count
     assert extra < 4.0, f"playing holds {extra:.1f} bytes per vertex more than Blender needs"
+
+
+def test_a_straight_axis_fish_keeps_4_bytes_per_vertex_of_binding(empty_scene):
+    # Along a straight rest axis the offsets (u, v) of the binding are the rest position's,
+    # an affine function of it: the Fish Swim tree computes them from Position and the mesh
+    # keeps only the parameter s, one float per vertex (12 bytes before; Blender 3.4 copies
+    # the mesh's attributes into its evaluated mesh, so there 8 bytes instead of 24).
+    set_fps(24)
+    obj = spindle_with_a_mouth(segments=96, rings=64)
+    before = {a.name for a in obj.data.attributes}
+    activate(obj)
+    add_swim(obj, head_axis="POS_X", preset="CARANGIFORM", frequency=2.0)
+    for frame in (2, 3):
+        _viewport_frame(obj, frame)
+    added = [a for a in obj.data.attributes if a.name not in before]
+    assert [(a.name, a.data_type, a.domain) for a in added] == [
+        (".kodawari_swim_s", "FLOAT", "POINT")
+    ]
+    shown = obj.evaluated_get(bpy.context.evaluated_depsgraph_get()).data
+    assert {a.name for a in shown.attributes} <= before, "nothing of the binding handed on"
+    assert np.abs(evaluated(obj) - rest(obj)).max() > 0.02, "and it swims"

@@ -5,9 +5,19 @@ the stack, its eye hides the swim, undo, save and reload); Remove Fish Swim leav
 exactly as it was; the mesh carries one 12-byte attribute per vertex, no shape keys."""
 
 import bpy
+import mathutils
 import numpy as np
 import pytest
-from fish_helpers import activate, add_swim, evaluated, make_fish, rest, set_fps, smooth_fish
+from fish_helpers import (
+    activate,
+    add_swim,
+    evaluated,
+    make_fish,
+    rest,
+    set_fps,
+    smooth_fish,
+    spindle_with_a_mouth,
+)
 
 MODIFIER = "Fish Swim"
 
@@ -27,6 +37,25 @@ def _route_equals_core(obj, frames):
     return worst, moved
 
 
+def _route_equals_full_binding(obj, frames):
+    """Like _route_equals_core, against a fresh binding that holds every coordinate itself
+    (nothing computed from the rest position, nothing released: the deform as before)."""
+    from kodawari.fish import rig as rig_module
+    from kodawari.fish import timing
+
+    scene = bpy.context.scene
+    settings = obj.kodawari_swim
+    whole = rig_module.SwimRig(obj, settings)
+    assert not whole.binding.released
+    worst = 0.0
+    for frame in frames:
+        scene.frame_set(frame)
+        phase, _ = timing.phase_and_distance(obj, settings, scene, frame, whole.body_length)
+        expected = whole.evaluate(settings, phase)
+        worst = max(worst, float(np.abs(evaluated(obj) - expected).max()) / whole.body_length)
+    return worst
+
+
 def _mesh_state(mesh):
     keys = mesh.shape_keys
     return {
@@ -40,6 +69,11 @@ def rest_of(mesh):
     out = np.empty((len(mesh.vertices), 3), dtype=np.float32)
     mesh.vertices.foreach_get("co", out.reshape(-1))
     return out
+
+
+def _stored(obj):
+    """Which of the bound (s, u, v) the mesh stores as attributes (the rest computed)."""
+    return "".join(c for c in "suv" if obj.data.attributes.find(f".kodawari_swim_{c}") >= 0)
 
 
 def _data_counts():
@@ -100,6 +134,9 @@ def test_the_modifier_shows_what_the_core_computes_on_a_smooth_fish_with_a_mouth
     worst, moved = _route_equals_core(obj, (3, 8, 11))
     assert moved > 0.02
     assert worst < 1e-5, f"{form}: the modifier is {worst:.2e} body lengths from the core"
+    assert _route_equals_full_binding(obj, (3, 8)) < 1e-5
+    # Its mid-line bends up and down only: v is computed from Position, not stored.
+    assert _stored(obj) == "su"
 
 
 def test_fish_swim_is_the_first_modifier_and_its_eye_hides_the_swim(empty_scene):
@@ -201,15 +238,17 @@ def test_a_duplicate_swims_with_its_own_settings(empty_scene):
 
 
 def test_the_live_mesh_carries_one_small_attribute_and_no_shape_key(empty_scene):
-    # Memory (issue 13 item 4): per vertex the swim adds 12 bytes to the user's mesh ((s, u,
-    # v), three floats); no shape key (a Basis and a swim key: 24 bytes more per vertex).
+    # Memory (issue 13 item 4): per vertex the swim adds at most 12 bytes to the user's mesh
+    # ((s, u, v), three floats); the tuna is the same on both sides, its rest axis never
+    # leaves the plane of its head and back, so v (across it) is computed from the rest
+    # position (docs/algorithms.md §1.6): 8 bytes. No shape key (24 bytes more per vertex).
     set_fps(24)
     obj = make_fish("tuna")
     names = {a.name for a in obj.data.attributes}
     add_swim(obj, head_axis="POS_X", frequency=2.0)
     bpy.context.scene.frame_set(3)
     added = [(a.name, a.data_type, a.domain) for a in obj.data.attributes if a.name not in names]
-    assert sorted(added) == [(f".kodawari_swim_{c}", "FLOAT", "POINT") for c in "suv"]
+    assert sorted(added) == [(f".kodawari_swim_{c}", "FLOAT", "POINT") for c in "su"]
     assert obj.data.shape_keys is None
     # ... and hands none on: what renders, exports and later modifiers see has no copy.
     shown = obj.evaluated_get(bpy.context.evaluated_depsgraph_get()).data
@@ -250,7 +289,8 @@ def test_a_file_saved_with_the_packed_float3_binding_swims_again(empty_scene):
     packed = rig.packed_coordinates().copy()
     mesh = obj.data
     for name in route.COORDINATES:  # what that version left in the file:
-        mesh.attributes.remove(mesh.attributes[name])
+        if mesh.attributes.find(name) >= 0:
+            mesh.attributes.remove(mesh.attributes[name])
     old = mesh.attributes.new(route.PACKED, "FLOAT_VECTOR", "POINT")
     old.data.foreach_set("vector", packed.reshape(-1))
     runtime.forget(obj)  # a file opened: the rigs are rebuilt
@@ -258,5 +298,189 @@ def test_a_file_saved_with_the_packed_float3_binding_swims_again(empty_scene):
     worst, moved = _route_equals_core(obj, (3, 5))
     assert moved > 0.02 and worst < 1e-5
     assert mesh.attributes.find(route.PACKED) < 0
-    assert all(mesh.attributes.find(name) >= 0 for name in route.COORDINATES)
+    assert _stored(obj) == "su"  # v computed from the rest position (the tuna's axis is planar)
     assert np.array_equal(rest(obj), original)
+
+
+def test_a_straight_axis_fish_stores_only_its_parameter(empty_scene):
+    # Along a straight rest axis u and v are the rest position's offsets across it, an affine
+    # function of Position, measured on every vertex at bind time (docs/algorithms.md §1.6);
+    # s is not (the clamped spline runs faster near its ends), so it alone is stored.
+    set_fps(24)
+    obj = spindle_with_a_mouth()
+    obj.scale = (0.01, 0.01, 0.01)  # modelled in centimetres
+    # ... away from its origin: u and v are offsets from an axis that does not pass through it
+    obj.data.transform(mathutils.Matrix.Translation((0.3, -0.2, 0.15)))
+    activate(obj)
+    assert bpy.ops.kodawari.swim_add(head_axis="POS_X", preset="CARANGIFORM", frequency=2.0) == {
+        "FINISHED"
+    }
+    worst, moved = _route_equals_core(obj, (3, 8))
+    assert moved > 0.02 and worst < 1e-5, worst
+    assert _route_equals_full_binding(obj, (3, 8)) < 1e-5
+    assert _stored(obj) == "s"
+    from kodawari.fish import route
+
+    offsets = route.modifier(obj).node_group["kodawari_offsets"]
+    assert np.abs(offsets) == pytest.approx((0.15, 0.2), abs=1e-6), "the axis's constants"
+    shown = obj.evaluated_get(bpy.context.evaluated_depsgraph_get()).data
+    assert not [a.name for a in shown.attributes if a.name.startswith(".kodawari")]
+
+
+def test_a_fish_curved_at_rest_keeps_every_coordinate(empty_scene):
+    # A smooth fish with a mouth modelled bent to one side: its rest axis curves, no
+    # coordinate is affine in the rest position, all three stay attributes, still exact.
+    set_fps(24)
+    obj = smooth_fish.build_smooth_fish("spindle", subdivisions=2)
+    co = rest(obj).astype(np.float64)
+    co[:, 1] += 0.12 * np.cos(np.pi * co[:, 0])  # a C to the side, snout and tail back
+    obj.data.vertices.foreach_set("co", co.astype(np.float32).reshape(-1))
+    obj.data.update()
+    obj.scale = (0.01, 0.01, 0.01)
+    activate(obj)
+    assert bpy.ops.kodawari.swim_add(preset="CARANGIFORM", frequency=2.0) == {"FINISHED"}
+    worst, moved = _route_equals_core(obj, (3, 8))
+    assert moved > 0.02 and worst < 1e-5, worst
+    assert _route_equals_full_binding(obj, (3, 8)) < 1e-5
+    assert _stored(obj) == "suv"
+
+
+def test_the_users_shape_keys_bring_the_stored_offsets_back(empty_scene):
+    # With shape keys Position is no longer the rest position: the offsets it gave are
+    # stored again, and the key still rides on the swim.
+    set_fps(24)
+    obj = make_fish("tuna")
+    add_swim(obj, head_axis="POS_X", frequency=2.0)
+    scene = bpy.context.scene
+    scene.frame_set(4)
+    assert _stored(obj) == "su"
+    swim = evaluated(obj).copy()
+    obj.shape_key_add(name="Basis", from_mix=False)
+    smile = obj.shape_key_add(name="Smile", from_mix=False)
+    offsets = np.zeros_like(swim)
+    offsets[:, 1] = 0.01  # across the body: what v would wrongly take as rest
+    smile.data.foreach_set("co", (rest(obj) + offsets).reshape(-1))
+    smile.value = 1.0
+    scene.frame_set(4)
+    assert _stored(obj) == "suv"
+    assert np.abs(evaluated(obj) - (swim + offsets)).max() < 1e-5
+    obj.shape_key_clear()  # and without them v is computed again
+    scene.frame_set(5)
+    assert _stored(obj) == "su"
+    worst, _ = _route_equals_core(obj, (5,))
+    assert worst < 1e-5
+
+
+def test_a_file_bound_with_every_coordinate_stored_binds_again(empty_scene):
+    # Files saved before stored all three (s, u, v) and their node group carries no mark of
+    # what it stores: on their next frame they are bound again, v computed, its attribute
+    # gone (4 bytes per vertex), the swim unchanged.
+    set_fps(24)
+    obj = make_fish("tuna")
+    original = rest(obj).copy()
+    settings = add_swim(obj, fins=("fin_caudal",), head_axis="POS_X", frequency=2.0)
+    from kodawari.fish import route, runtime
+
+    scene = bpy.context.scene
+    scene.frame_set(6)
+    before = evaluated(obj).copy()
+    rig = runtime.get_rig(obj)
+    packed = rig.packed_coordinates().copy()
+    mesh = obj.data
+    mod = route.modifier(obj)
+    group = mod.node_group
+    # What that version left in the file: its tree read all three, unmarked ...
+    mod.node_group = route.build_group(
+        group.nodes["frames"].inputs[0].default_value,
+        group.nodes["fins"].inputs[0].default_value,
+        rig.end_scale,
+        with_ends=route.has_ends(packed),
+    )
+    bpy.data.node_groups.remove(group)
+    del mod.node_group["kodawari_stored"]
+    mod.node_group["kodawari_with_keys"] = False
+    # ... from three attributes
+    mesh.attributes.new(route.COORDINATES[2], "FLOAT", "POINT").data.foreach_set(
+        "value", np.ascontiguousarray(packed[:, 2])
+    )
+    runtime.forget(obj)  # a file opened: the rigs are rebuilt
+    assert settings.enabled and runtime.has_swim(obj) and _stored(obj) == "suv"
+    scene.frame_set(5)
+    scene.frame_set(6)
+    assert _stored(obj) == "su"
+    assert np.abs(evaluated(obj) - before).max() < 1e-5
+    worst, moved = _route_equals_core(obj, (3, 5))
+    assert moved > 0.02 and worst < 1e-5
+    assert np.array_equal(rest(obj), original)
+
+
+def test_bake_and_apply_give_what_the_core_gave_from_every_stored_coordinate(empty_scene, tmp_path):
+    # Bake and Apply deform in the core from the bound attributes and, for a coordinate the
+    # route computes, the same affine row of the rest position: the shape is what a binding
+    # holding every coordinate itself (as before) gives.
+    set_fps(24)
+    obj = make_fish("dolphin")
+    settings = add_swim(obj, fins=("fin_pectoral",), head_axis="POS_X", preset="CETACEAN")
+    scene = bpy.context.scene
+    scene.frame_set(9)
+    from kodawari.fish import bake, timing
+    from kodawari.fish import rig as rig_module
+
+    assert _stored(obj) == "su"
+    whole = rig_module.SwimRig(obj, settings)  # a fresh binding, nothing released
+    assert not whole.binding.released
+
+    def as_before(frame):
+        phase, _ = timing.phase_and_distance(obj, settings, scene, frame, whole.body_length)
+        return whole.evaluate(settings, phase).copy()
+
+    cache = str(tmp_path / "dolphin.pc2")
+    activate(obj)
+    result = bpy.ops.kodawari.swim_bake(
+        frame_start=3, frame_end=5, target="MESH_CACHE", filepath=cache
+    )
+    assert result == {"FINISHED"}
+    _, _, baked = bake.read_pc2(cache)
+    for k, frame in enumerate((3, 4, 5)):
+        assert np.abs(baked[k] - as_before(frame)).max() < 1e-6 * whole.body_length, frame
+    assert bpy.ops.kodawari.swim_free_bake() == {"FINISHED"}
+    scene.frame_set(9)
+    before = as_before(9)
+    shown = evaluated(obj).copy()
+    activate(obj)
+    assert bpy.ops.kodawari.swim_apply() == {"FINISHED"}
+    assert np.abs(rest(obj) - before).max() < 1e-6 * whole.body_length
+    assert np.abs(shown - before).max() < 1e-5 * whole.body_length
+
+
+@pytest.mark.parametrize("head_axis", ["NEG_X", "POS_Y"])
+def test_a_computed_offset_along_a_negative_object_axis_is_exact(empty_scene, head_axis):
+    # Heading -X or +Y the side axis is an object axis turned over: the tree reads v as
+    # that axis's coordinate of Position and the table's e3 turns over instead (route._rows).
+    from kodawari.fish import route
+
+    set_fps(24)
+    obj = make_fish("tuna", head_axis=head_axis)
+    add_swim(obj, fins=("fin_pectoral",), head_axis=head_axis, frequency=2.0)
+    worst, moved = _route_equals_core(obj, (3, 7))
+    assert moved > 0.02 and worst < 1e-5, worst
+    assert _route_equals_full_binding(obj, (3, 7)) < 1e-5
+    assert _stored(obj) == "su"
+    assert list(route.modifier(obj).node_group["kodawari_signs"]) == [1.0, -1.0]
+
+
+def test_a_computed_offset_off_the_object_axes_reads_a_dot_product(empty_scene, monkeypatch):
+    # A row that is not an object axis (a rest axis modelled at a slant) is read as
+    # Dot Product(Position, n); the same shape.
+    from kodawari.fish import route
+
+    monkeypatch.setattr(route, "_object_axis", lambda row: None)
+    set_fps(24)
+    obj = make_fish("tuna", head_axis="NEG_X")
+    add_swim(obj, head_axis="NEG_X", frequency=2.0)
+    nodes = route.modifier(obj).node_group.nodes
+    assert any(n.type == "VECT_MATH" and n.operation == "DOT_PRODUCT" for n in nodes)
+    assert not any(n.type == "SEPXYZ" for n in nodes)
+    worst, moved = _route_equals_core(obj, (3, 7))
+    assert moved > 0.02 and worst < 1e-5, worst
+    assert _route_equals_full_binding(obj, (3, 7)) < 1e-5

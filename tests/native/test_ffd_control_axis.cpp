@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <stdexcept>
@@ -190,4 +191,73 @@ TEST(FfdControlAxis, PackedCoordinatesAndTheFrameTableGiveDeformsPositions) {
   std::vector<float> out(3 * count);
   deform_packed(table, packed.data(), count, end_scale, out.data());
   EXPECT_LT(max_distance(out, expected), 1e-5 * length);
+}
+
+namespace {
+// A clamped uniform cubic B-spline is linear in t when its control points sit at the knots'
+// Greville abscissae (the mean of each point's three inner knots): linear precision.
+Vec3List greville_line(int n, Real length) {
+  std::vector<Real> knots(n + 4);
+  for (int i = 0; i < n + 4; ++i) knots[i] = std::clamp(Real(i - 3) / Real(n - 3), Real(0), Real(1));
+  Vec3List points;
+  for (int i = 0; i < n; ++i) points.emplace_back(length * (knots[i + 1] + knots[i + 2] + knots[i + 3]) / 3, 0, 0);
+  return points;
+}
+
+std::vector<float> packed_of(const AxisBinding& binding, float end_scale) {
+  std::vector<float> packed(3 * binding.count());
+  binding.packed_coordinates(end_scale, packed.data());
+  return packed;
+}
+}  // namespace
+
+// docs/algorithms.md §1.6: which packed coordinates are affine in the rest position is
+// measured on every vertex, never assumed; the rows that hold give the bound values.
+TEST(FfdAffineCoordinates, AStraightAxisGivesAffineOffsetsAndItsParameterOnlyWhenLinearInT) {
+  const std::size_t count = 20000;
+  const std::vector<float> mesh = fixtures::box_mesh(count);  // caps past both ends too
+  const Real length = 4;
+  const float end_scale = float(kTableSegments / length);
+  // Evenly spaced control points: the clamped ends make t run faster near the ends, so s is
+  // not affine, while u and v are (the frames never turn along a straight axis).
+  const AxisBinding even(fixtures::straight_axis(8, length), mesh.data(), count, {}, std::nullopt);
+  const AffineCoordinates a = even.affine_coordinates(mesh.data(), count, end_scale, 1e-6);
+  EXPECT_FALSE(a.holds[0]);
+  EXPECT_GT(a.worst[0], 1e-3);
+  EXPECT_TRUE(a.holds[1] && a.holds[2]);
+  // Control points at the Greville abscissae: t is proportional to the arc, s is affine too,
+  // beyond the ends included (there s = w * end_scale, the same slope).
+  const AxisBinding linear(greville_line(8, length), mesh.data(), count, {}, std::nullopt);
+  const AffineCoordinates b = linear.affine_coordinates(mesh.data(), count, end_scale, 1e-6);
+  EXPECT_TRUE(b.holds[0] && b.holds[1] && b.holds[2]) << b.worst[0] << " " << b.worst[1] << " " << b.worst[2];
+
+  // What fill_affine_coordinates writes from the rest positions deforms like the bound values.
+  std::vector<float> packed = packed_of(linear, end_scale);
+  std::vector<float> computed(packed.size(), -1.0f);
+  fill_affine_coordinates(b, mesh.data(), count, computed.data());
+  Vec3List bent = greville_line(8, length);
+  for (std::size_t i = 0; i < bent.size(); ++i) bent[i] += Vec3(0, 0.4 * std::sin(0.9 * Real(i)), 0);
+  FrameTable table;
+  linear.frame_table(bent, {}, std::nullopt, table);
+  std::vector<float> from_bound(packed.size()), from_rest(packed.size());
+  deform_packed(table, packed.data(), count, end_scale, from_bound.data());
+  deform_packed(table, computed.data(), count, end_scale, from_rest.data());
+  EXPECT_LT(max_distance(from_rest, from_bound), 2e-6 * length);
+}
+
+TEST(FfdAffineCoordinates, ACurvedAxisKeepsEveryCoordinateAndARowThatHoldsIsTheOnlyOneWritten) {
+  const Vec3List rest = fixtures::s_curve(16);
+  const std::size_t count = 5000;
+  const std::vector<float> mesh = tube_around(rest, count);
+  const AxisBinding binding(rest, mesh.data(), count, {}, std::nullopt);
+  const float length = static_cast<float>(curve_length(CubicBSpline(rest)));
+  const AffineCoordinates a = binding.affine_coordinates(mesh.data(), count, float(kTableSegments) / length, 1e-6);
+  EXPECT_FALSE(a.holds[0] || a.holds[1] || a.holds[2]);
+  std::vector<float> packed(3 * count, 7.0f);
+  fill_affine_coordinates(a, mesh.data(), count, packed.data());
+  for (float value : packed) ASSERT_EQ(value, 7.0f);
+  EXPECT_THROW(binding.affine_coordinates(mesh.data(), count - 1, 1.0f, 1e-6), std::invalid_argument);
+  AxisBinding released(rest, mesh.data(), count, {}, std::nullopt);
+  released.release_coordinates();
+  EXPECT_THROW(released.affine_coordinates(mesh.data(), count, 1.0f, 1e-6), std::logic_error);
 }

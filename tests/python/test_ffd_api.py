@@ -83,3 +83,29 @@ def test_preserve_lengths_restores_every_segment():
 def test_wrong_control_point_count_raises():
     with pytest.raises(ValueError, match="control_points"):
         kn.ffd_bind(straight_axis(3), box_mesh(10))
+
+
+def test_affine_coordinates_measure_each_packed_coordinate_and_fill_only_those_that_hold():
+    # docs/algorithms.md §1.6: along a straight axis u and v are the rest position's offsets
+    # (affine); s is not with evenly spaced points (the clamped spline's ends run faster).
+    axis = straight_axis(6)
+    mesh = box_mesh() + np.float32([0.0, 0.5, -0.25])  # an axis away from the origin
+    binding = kn.ffd_bind(axis, mesh)
+    end_scale = 1024 / 4.0
+    rows, holds, worst = binding.affine_coordinates(mesh, end_scale, 1e-6)
+    assert rows.dtype == np.float32 and rows.shape == (3, 4)
+    assert holds == (False, True, True), worst
+    assert worst[0] > 1e-3 and max(worst[1:]) <= 1e-6
+    packed = binding.packed_coordinates(end_scale)
+    filled = np.full_like(packed, 7.0)
+    kn.ffd_fill_affine_coordinates(rows, holds, mesh, filled)
+    assert np.all(filled[:, 0] == 7.0), "s does not hold: left as it was"
+    assert np.abs(filled[:, 1:] - packed[:, 1:]).max() <= 1e-6 * 4.0
+    with pytest.raises(ValueError, match="vertices"):
+        binding.affine_coordinates(mesh[:-1], end_scale, 1e-6)
+    with pytest.raises(ValueError, match="rows"):
+        kn.ffd_fill_affine_coordinates(rows[:2], holds, mesh, filled)
+    with pytest.raises(ValueError, match="packed"):
+        kn.ffd_fill_affine_coordinates(rows, holds, mesh, filled[:-1])
+    with pytest.raises(ValueError, match="holds"):
+        kn.ffd_fill_affine_coordinates(rows, holds[:2], mesh, filled)

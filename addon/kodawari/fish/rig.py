@@ -8,6 +8,7 @@ deform on its own vertices, carried by the body's rotation at the fin root.
 import hashlib
 
 import numpy as np
+from bpy.app.translations import pgettext_tip as tip_
 
 from .. import bulk, native
 from . import fins as fin_setup
@@ -15,6 +16,10 @@ from . import midline, route
 
 SHAPE_KEY = "Kodawari Swim"  # the swim's shape key before the node route (kept for old files)
 TABLE_SEGMENTS = 1024  # the core's frame table (native/include/kodawari/ffd/frame_table.hpp)
+# How close an affine row must give a bound coordinate to be computed from the rest position
+# instead of stored (docs/algorithms.md §1.6), in body lengths: a tenth of the route's exactness
+# bound (1e-5, tests/blender/test_fish_route.py), the rest left to the nodes' float rounding.
+AFFINE_TOLERANCE = 1e-6
 PROBE_SCALE = (
     0.02  # probe arm length (fraction of body length) for the body's rotation at a fin root
 )
@@ -73,6 +78,11 @@ class SwimRig:
             rest, settings.head_axis, settings.control_points
         )
         self.binding = kn.ffd_bind(self.axis_rest, rest, up=self.up)
+        # Which of the bound (s, u, v) are n . P + c of the rest position, measured on every
+        # vertex (docs/algorithms.md §1.6): the route computes those from Position.
+        self.affine_rows, self.affine_holds, self.affine_worst = self.binding.affine_coordinates(
+            rest, self.end_scale, AFFINE_TOLERANCE
+        )
         self.axis = self.axis_rest.copy()
         self.parts = []
         known_weights = known_weights or {}
@@ -172,15 +182,25 @@ class SwimRig:
         return TABLE_SEGMENTS / max(float(self.body_length), 1e-12)
 
     def packed_coordinates(self):
-        """float32 (N, 3): each vertex's (s, u, v), the route's bound attribute (read back
-        from the mesh once the binding released its own copy)."""
+        """float32 (N, 3): each vertex's (s, u, v), the route's bound attributes (read back
+        from the mesh once the binding released its own copy; a coordinate the route computes
+        from the rest position is computed the same way here)."""
         if not self.binding.released:
             return self.binding.packed_coordinates(self.end_scale)
         out = np.empty((self.count, 3), dtype=np.float32)
         column = np.empty(self.count, dtype=np.float32)
+        mesh = self.owner.data
+        computed = [not route.has_attribute(mesh, name) for name in route.COORDINATES]
         for k, name in enumerate(route.COORDINATES):
-            self.owner.data.attributes[name].data.foreach_get("value", column)
-            out[:, k] = column
+            if not computed[k]:
+                mesh.attributes[name].data.foreach_get("value", column)
+                out[:, k] = column
+        if any(computed):
+            if not all(h for h, c in zip(self.affine_holds, computed) if c):
+                raise ValueError(
+                    tip_("the swim's bound attributes are missing: add the Fish Swim again")
+                )
+            self.kn.ffd_fill_affine_coordinates(self.affine_rows, computed, self.rest, out)
         return out
 
     def release_coordinates(self):

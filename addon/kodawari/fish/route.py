@@ -1,8 +1,9 @@
 """Fish Swim as a Geometry Nodes modifier (docs/algorithms.md §1.6).
 
 The live swim bends the fish inside Blender's own evaluation: a "Fish Swim" Geometry
-Nodes modifier, first in the stack, reads each vertex's bound FFD coordinates (three
-float attributes, bound once) and the current frame table (1024 segments x 8 vectors
+Nodes modifier, first in the stack, reads each vertex's bound FFD coordinates (float
+attributes, bound once; a coordinate the rest axis makes affine in the rest position is
+computed from Position instead, measured at bind time) and the current frame table (1024 segments x 8 vectors
 and the tail's frame, written per frame into a small helper mesh) and sets the bent
 positions with Sample Index nodes. Moving fins add a per-vertex offset the core computes per frame for the
 fin vertices only, written into a second helper mesh and read by an index attribute.
@@ -109,6 +110,14 @@ class _Tree:
         self.links.new(c, node.inputs[2])
         return node.outputs[0]
 
+    def affine(self, position, row, constant=True):
+        """row[:3] . position (+ row[3]): a bound coordinate from the rest position."""
+        dot = self.node("ShaderNodeVectorMath", operation="DOT_PRODUCT")
+        self.links.new(position, dot.inputs[0])
+        dot.inputs[1].default_value = tuple(float(x) for x in row[:3])
+        value = _enabled(dot.outputs)
+        return self.math("ADD", value, float(row[3])) if constant else value
+
     def sample(self, geometry, attribute, index):
         node = self.node("GeometryNodeSampleIndex", data_type="FLOAT_VECTOR", domain="POINT")
         self.links.new(geometry, node.inputs["Geometry"])
@@ -122,18 +131,44 @@ class _Tree:
         return info.outputs["Geometry"]
 
 
-def build_group(table_obj, fins_obj, end_scale, with_keys=False, with_ends=True):
+def build_group(
+    table_obj, fins_obj, end_scale, with_keys=False, with_ends=True, rows=None, computed=None
+):
     """P' = (O + u e2 + v e3 + w e1) + f (dO + u de2 + v de3 + w de1) [+ fin offset], the
     core's deform_vertex (docs/algorithms.md §1.4, §1.6) in nodes. with_ends: some vertex
-    lies past an end of the axis (w != 0); without, the w terms are left out."""
+    lies past an end of the axis (w != 0); without, the w terms are left out. computed[k]:
+    coordinate k (of s, u, v) is rows[k][:3] . Position + rows[k][3] (the rest position:
+    never with the user's shape keys), not a stored attribute; for u and v the constant
+    rows[k][3] rides in the frame table's origins instead (write_frame)."""
+    computed = computed or (False, False, False)
     group = bpy.data.node_groups.new(GROUP, "GeometryNodeTree")
     group["kodawari_swim"] = 1
+    group["kodawari_stored"] = stored_letters(computed)
+    group["kodawari_offsets"] = [float(rows[k][3]) if computed[k] else 0.0 for k in (1, 2)]
+    # A computed u or v whose row is an object axis (the set-up's head, up and side are)
+    # is that axis's coordinate of Position, from one Separate XYZ: cheaper than a Dot
+    # Product each; the row's sign rides in the table's e2 or e3 (write_frame).
+    axes = [_object_axis(rows[k]) if computed[k] else None for k in (1, 2)]
+    group["kodawari_signs"] = [axis[1] if axis else 1.0 for axis in axes]
     _new_socket(group, "Geometry", "INPUT")
     _new_socket(group, "Geometry", "OUTPUT")
     tree = _Tree(group)
     group_in, group_out = tree.node("NodeGroupInput"), tree.node("NodeGroupOutput")
     table = tree.object_geometry("frames", table_obj)
-    s, u, v = (tree.named(name, "FLOAT") for name in COORDINATES)
+    position = tree.node("GeometryNodeInputPosition").outputs[0] if any(computed) else None
+    separate = None
+    if any(axes):
+        separate = tree.node("ShaderNodeSeparateXYZ")
+        tree.links.new(position, separate.inputs[0])
+
+    def coordinate(k, name):
+        if not computed[k]:
+            return tree.named(name, "FLOAT")
+        if k > 0 and axes[k - 1]:
+            return separate.outputs[axes[k - 1][0]]
+        return tree.affine(position, rows[k], constant=k == 0)
+
+    s, u, v = (coordinate(k, name) for k, name in enumerate(COORDINATES))
     t, w = s, None
     if with_ends:
         clamp = tree.node("ShaderNodeClamp")
@@ -187,7 +222,8 @@ def build_group(table_obj, fins_obj, end_scale, with_keys=False, with_ends=True)
     # The bound attributes stay on the user's mesh, not on what the swim hands on: Blender
     # 3.4 copies the mesh for Set Position (the attribute too, 12 bytes per vertex more
     # until the next frame), and exports and later modifiers have no use for them.
-    for name in (*COORDINATES, FIN_INDEX) if fins_obj is not None else COORDINATES:
+    stored = [name for name, c in zip(COORDINATES, computed) if not c]
+    for name in (*stored, FIN_INDEX) if fins_obj is not None else stored:
         remove = tree.node("GeometryNodeRemoveAttribute")
         remove.inputs["Name"].default_value = name
         tree.links.new(result, remove.inputs["Geometry"])
@@ -199,18 +235,49 @@ def build_group(table_obj, fins_obj, end_scale, with_keys=False, with_ends=True)
 # ----------------------------------------------------------------------------- set-up
 
 
+def stored_letters(computed):
+    """Which of s, u, v the route stores as attributes, as letters ("suv" before any was
+    computed: the node groups of older files carry no mark and store all three)."""
+    return "".join(letter for letter, c in zip("suv", computed) if not c)
+
+
+def stored_names(group):
+    letters = group.get("kodawari_stored", "suv")
+    return [name for letter, name in zip("suv", COORDINATES) if letter in letters]
+
+
+def _object_axis(row):
+    """(index, sign) when row[:3] is exactly plus or minus one object axis, else None."""
+    normal = [float(x) for x in row[:3]]
+    for index, value in enumerate(normal):
+        if abs(value) == 1.0 and all(x == 0.0 for i, x in enumerate(normal) if i != index):
+            return index, value
+    return None
+
+
 def has_ends(packed):
     """Some vertex lies past an end of the axis (w != 0: s outside [0, 1024])."""
     return bool(np.any((packed[:, 0] < 0.0) | (packed[:, 0] > float(SEGMENTS))))
 
 
-def _rows(table, out):
+def _rows(table, out, offsets=(0.0, 0.0), signs=(1.0, 1.0)):
     """The core's frame table (8 * 1024, 3) as the helper's rows (8, 1025, 3): each field's
-    1024 segments, then the tail's frame (value + change of the last segment, no change)."""
+    1024 segments, then the tail's frame (value + change of the last segment, no change).
+    offsets (c_u, c_v): the constants of u and v where the tree computes them from Position
+    as n . P alone; O + u e2 + v e3 = (O + c_u e2 + c_v e3) + (n_u . P) e2 + (n_v . P) e3, so
+    they are added to the origins (and their changes) here, once per row, not per vertex.
+    signs: -1 where the tree reads u or v as an object axis's coordinate, the negative of
+    n . P: e2 or e3 (and its change) turn over instead."""
     segments = table.reshape(len(FIELDS), SEGMENTS, 3)
     out[:, :SEGMENTS] = segments
     out[0::2, SEGMENTS] = segments[0::2, -1] + segments[1::2, -1]  # o, e1, e2, e3 at t = 1
     out[1::2, SEGMENTS] = 0.0
+    c_u, c_v = offsets
+    if c_u or c_v:
+        out[0:2] += np.float32(c_u) * out[4:6] + np.float32(c_v) * out[6:8]  # o, do from e2, e3
+    for sign, fields in zip(signs, (slice(4, 6), slice(6, 8))):
+        if sign < 0:
+            out[fields] *= np.float32(-1.0)
     return out
 
 
@@ -269,14 +336,21 @@ def install(obj, rig):
         _remove_helpers(mod)
     else:
         mod = obj.modifiers.new(MODIFIER, "NODES")
+    with_keys = mesh.shape_keys is not None
     packed = rig.packed_coordinates()
     with_ends = has_ends(packed)
+    # A coordinate the rest axis makes affine in the rest position (measured on every vertex
+    # at bind time, docs/algorithms.md §1.6) is computed from Position: no attribute. With
+    # the user's shape keys Position is not the rest position, so all three are stored.
+    computed = tuple(bool(h) and not with_keys for h in rig.affine_holds)
     for k, name in enumerate(COORDINATES):
-        _write_attribute(mesh, name, "FLOAT", np.ascontiguousarray(packed[:, k]))
+        if not computed[k]:
+            _write_attribute(mesh, name, "FLOAT", np.ascontiguousarray(packed[:, k]))
+        elif has_attribute(mesh, name):
+            mesh.attributes.remove(mesh.attributes[name])
     del packed
     if mesh.attributes.get(PACKED) is not None:
         mesh.attributes.remove(mesh.attributes[PACKED])
-    with_keys = mesh.shape_keys is not None
     rest_fields = tuple(REST + f for f in FIELDS) if with_keys else ()
     table_obj = _helper_object(TABLE, ROWS, FIELDS + rest_fields)
     if with_keys:
@@ -291,7 +365,9 @@ def install(obj, rig):
         fins_obj = _helper_object(FINS, len(rig.fin_vertices), (FIN_OFFSET,))
     elif mesh.attributes.get(FIN_INDEX) is not None:
         mesh.attributes.remove(mesh.attributes[FIN_INDEX])
-    mod.node_group = build_group(table_obj, fins_obj, rig.end_scale, with_keys, with_ends)
+    mod.node_group = build_group(
+        table_obj, fins_obj, rig.end_scale, with_keys, with_ends, rig.affine_rows, computed
+    )
     mod.node_group["kodawari_with_keys"] = with_keys
     # In Edit Mode the user edits the rest shape: show it, as the shape key used to.
     mod.show_in_editmode = False
@@ -322,7 +398,7 @@ def installed_for(obj, rig):
         return False
     mesh = obj.data
     return (
-        all(has_attribute(mesh, name) for name in COORDINATES)
+        all(has_attribute(mesh, name) for name in stored_names(mod.node_group))
         and (rig.fin_vertices is None) != has_attribute(mesh, FIN_INDEX)
         # shape keys added or removed since: the tree reads their offset, or not
         and bool(mod.node_group.get("kodawari_with_keys")) == (mesh.shape_keys is not None)
@@ -353,7 +429,9 @@ def write_frame(obj, table, fin_offsets):
     table_mesh, fins_mesh = helpers(obj)
     if table_mesh is None:
         return False
-    rows = _rows(table, _row_buffer)
+    group = modifier(obj).node_group
+    offsets = group.get("kodawari_offsets", (0.0, 0.0))
+    rows = _rows(table, _row_buffer, tuple(offsets), tuple(group.get("kodawari_signs", (1.0, 1.0))))
     for k, name in enumerate(FIELDS):
         table_mesh.attributes[name].data.foreach_set("vector", rows[k].reshape(-1))
     table_mesh.update_tag()

@@ -552,6 +552,7 @@ STRINGS = {
     "the ground '{}' does not lie under the whole run ({} of {} rays missed): move or enlarge it, or clear Ground": "地面 '{0}' が移動経路全体の下にありません（{2} 本中 {1} 本のレイが外れました）：移動または拡大するか、地面を解除してください",
     "the ground '{}' is out of the legs' reach (a planted foot misses it by {:.2f} m at frame {})": "地面 '{0}' が脚の届く範囲外です（フレーム {2} で接地した足が {1:.2f} m 届きません）",
     "the path curve '{}' has no length": "パスのカーブ '{}' に長さがありません",
+    "the swim's bound attributes are missing: add the Fish Swim again": "泳ぎのバインド属性がありません：魚の泳ぎをもう一度追加してください",
     "vertex group '{}' does not stand out from the body": "頂点グループ '{}' が体から突き出ていません",
     "vertex group '{}' has fewer than 4 vertices": "頂点グループ '{}' の頂点が4個未満です",
     "vertex group '{}' has no length along the body": "頂点グループ '{}' に体に沿った長さがありません",

@@ -118,6 +118,23 @@ AxisBinding::AxisBinding(const Vec3List& control_points, const float* vertices, 
   FrameTable table;
   fill_frame_table(frames, table);
   const ClosestPointFinder finder(curve);
+  {
+    // Along a straight rest axis with the frames of its start, s, u and v would be affine in
+    // P: u = e2 . (P - O0), v = e3 . (P - O0), s = 1024 e1 . (P - O0) / span. Whether they are
+    // is decided on the vertices (affine_coordinates), never assumed.
+    const TableSegment& first = table.front();
+    const TableSegment& last = table.back();
+    const Vec3 o0 = first.origin.head<3>().cast<Real>();
+    const Vec3 o1 = (last.origin + last.d_origin).head<3>().cast<Real>();
+    const Vec3 e1 = first.e1.head<3>().cast<Real>();
+    const auto row = [&](const Vec3& n) {
+      return AffineRow{float(n.x()), float(n.y()), float(n.z()), float(-n.dot(o0))};
+    };
+    const Real span = e1.dot(o1 - o0);
+    rest_rows_[0] = span > 0 ? row(e1 * (Real(kTableSegments) / span)) : AffineRow{};
+    rest_rows_[1] = row(first.e2.head<3>().cast<Real>());
+    rest_rows_[2] = row(first.e3.head<3>().cast<Real>());
+  }
 
   coordinates_.resize(count);
   parallel_for(count, threads, kMinBindVerticesPerThread, [&](std::size_t begin, std::size_t end) {
@@ -192,23 +209,51 @@ void AxisBinding::frame_table(const Vec3List& control_points, const std::vector<
   require_finite_positions(table, reach_);
 }
 
+namespace {
+float packed_s(const AxisCoordinate& c, float end_scale) {
+  float s = static_cast<float>(c.segment) + c.fraction;
+  if (c.w != 0.0f) {
+    // Only a vertex at an end has w != 0: before the head w <= 0 (its closest curve
+    // point is the head, so it lies behind the head's tangent plane), after the
+    // tail w >= 0. The sign keeps s outside [0, kTableSegments], where the reader
+    // finds w again as (s - clamp(s)) / end_scale.
+    const bool head = c.segment == 0 && c.fraction == 0.0f;
+    s = head ? std::min(c.w, 0.0f) * end_scale : float(kTableSegments) + std::max(c.w, 0.0f) * end_scale;
+  }
+  return s;
+}
+}  // namespace
+
 void AxisBinding::packed_coordinates(float end_scale, float* out) const {
   if (released_) throw std::logic_error("the binding's coordinates were released");
   for (std::size_t i = 0; i < coordinates_.size(); ++i) {
     const AxisCoordinate& c = coordinates_[i];
-    float s = static_cast<float>(c.segment) + c.fraction;
-    if (c.w != 0.0f) {
-      // Only a vertex at an end has w != 0: before the head w <= 0 (its closest curve
-      // point is the head, so it lies behind the head's tangent plane), after the
-      // tail w >= 0. The sign keeps s outside [0, kTableSegments], where the reader
-      // finds w again as (s - clamp(s)) / end_scale.
-      const bool head = c.segment == 0 && c.fraction == 0.0f;
-      s = head ? std::min(c.w, 0.0f) * end_scale : float(kTableSegments) + std::max(c.w, 0.0f) * end_scale;
-    }
-    out[3 * i] = s;
+    out[3 * i] = packed_s(c, end_scale);
     out[3 * i + 1] = c.u;
     out[3 * i + 2] = c.v;
   }
+}
+
+AffineCoordinates AxisBinding::affine_coordinates(const float* vertices, std::size_t count, float end_scale,
+                                                  double tolerance) const {
+  if (released_) throw std::logic_error("the binding's coordinates were released");
+  if (count != count_) throw std::invalid_argument("vertices must be the bound rest positions");
+  AffineCoordinates affine;
+  affine.rows = rest_rows_;
+  // Misses in body lengths: s counts 1024 segments per body length, u and v are lengths.
+  const double length = double(kTableSegments) / double(end_scale);
+  const double per_unit[3] = {1.0 / kTableSegments, 1.0 / length, 1.0 / length};
+  for (std::size_t i = 0; i < count; ++i) {
+    const AxisCoordinate& c = coordinates_[i];
+    const float bound[3] = {packed_s(c, end_scale), c.u, c.v};
+    for (int k = 0; k < 3; ++k) {
+      const double miss = std::abs(double(affine_value(rest_rows_[k], vertices + 3 * i)) - double(bound[k]));
+      // A non-finite row (a degenerate axis) never holds.
+      affine.worst[k] = std::isfinite(miss) ? std::max(affine.worst[k], miss * per_unit[k]) : HUGE_VAL;
+    }
+  }
+  for (int k = 0; k < 3; ++k) affine.holds[k] = affine.worst[k] <= tolerance;
+  return affine;
 }
 
 void AxisBinding::deform(const Vec3List& control_points, const std::vector<Real>& twist,

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "kodawari/common.hpp"
+#include "kodawari/ffd/affine_coordinates.hpp"
 #include "kodawari/ffd/bspline.hpp"
 #include "kodawari/ffd/frame_table.hpp"
 #include "kodawari/ffd/frames.hpp"
@@ -56,6 +57,15 @@ class AxisBinding {
   // kTableSegments + w * end_scale after the tail. Writes 3 * count() floats.
   void packed_coordinates(float end_scale, float* out) const;
 
+  // Which packed coordinates (s, u, v) are an affine function of the rest position
+  // (docs/algorithms.md §1.6): rows derived from the rest axis (its start frame and its span
+  // along the start tangent), each kept only if it gives that coordinate of every one of the
+  // bound `vertices` (the rest positions bound, `count` xyz triples) to within `tolerance`
+  // body lengths, evaluated in float as affine_value does. Throws std::logic_error once
+  // released.
+  AffineCoordinates affine_coordinates(const float* vertices, std::size_t count, float end_scale,
+                                       double tolerance) const;
+
   // Frees the per-vertex coordinates (20 bytes per vertex) once they live elsewhere (the
   // packed attribute of the Blender mesh): frame_table() still works; deform() and
   // packed_coordinates() then throw std::logic_error (use deform_packed).
@@ -68,6 +78,7 @@ class AxisBinding {
   Vec3 rest_tangent_ = Vec3::UnitX();
   Vec3 rest_normal_ = Vec3::UnitY();
   std::vector<AxisCoordinate> coordinates_;
+  std::array<AffineRow, 3> rest_rows_{};  // s, u, v as n . P + c if the rest axis were straight
   float reach_ = 0;  // the largest |u|, |v|, |w| bound: with the frame table it bounds |P'|
   bool released_ = false;
   std::size_t count_ = 0;
