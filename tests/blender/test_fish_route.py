@@ -2,7 +2,8 @@
 what Blender shows equals what the core computes (bake, apply), on the sample fish and on a
 smooth high-poly fish with a mouth and found fins; the modifier behaves like one (first in
 the stack, its eye hides the swim, undo, save and reload); Remove Fish Swim leaves the mesh
-exactly as it was; the mesh carries one 12-byte attribute per vertex, no shape keys."""
+exactly as it was; the mesh carries no shape keys and, per vertex, only the bound
+coordinates its rest position does not give (4-12 bytes)."""
 
 import bpy
 import mathutils
