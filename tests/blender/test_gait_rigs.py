@@ -219,9 +219,20 @@ def test_walk_gallop_walk_on_the_rig(empty_scene, case, fps):
         assert ratio <= 1.0, (case, leg, ratio)
 
 
-# The rigs measured at 240 fps: the large ones and the fox-sized ones, whose joints turn
-# fastest (angular speeds grow as 1/sqrt(size) at Froude-scaled speeds).
-RIGS_240 = ("horse", "sample_horse", "wolf", "cat@0.01", "game", "game@0.01/object")
+# The rigs measured at 240 fps: the large ones, the fox-sized ones, whose joints turn
+# fastest (angular speeds grow as 1/sqrt(size) at Froude-scaled speeds), and the fox-sized
+# rig under every naming convention, scale and body bone the set-up tests read.
+RIGS_240 = (
+    "horse",
+    "sample_horse",
+    "wolf",
+    "cat@0.01",
+    "game",
+    "game@0.01/object",
+    "mixamo@0.01",
+    "unreal+connected",
+    "max_biped@0.01+connected",
+)
 
 
 @pytest.mark.parametrize("case,fps", [(c, 240) for c in RIGS_240] + [("mixamo@0.01", 60)])
