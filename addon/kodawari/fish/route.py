@@ -52,11 +52,8 @@ def _helper(group, label):
     return node.inputs[0].default_value if node is not None else None
 
 
-def helpers(obj):
-    """(frame table mesh, fin offset mesh or None) of the object's Fish Swim, or (None, None)."""
-    mod = modifier(obj)
-    if mod is None:
-        return None, None
+def helpers(mod):
+    """(frame table mesh, fin offset mesh or None) of a Fish Swim modifier."""
     table = _helper(mod.node_group, "frames")
     fins = _helper(mod.node_group, "fins")
     return (
@@ -426,10 +423,13 @@ _row_buffer = np.empty((len(FIELDS), ROWS, 3), np.float32)
 def write_frame(obj, table, fin_offsets):
     """The frame's table (float32 (8 * 1024, 3)) and fin offsets (float32 (M, 3) or None)
     into the helpers; tags them so Blender re-evaluates the modifier."""
-    table_mesh, fins_mesh = helpers(obj)
+    mod = modifier(obj)  # looked up once a frame: the helpers and the constants hang on it
+    if mod is None:
+        return False
+    table_mesh, fins_mesh = helpers(mod)
     if table_mesh is None:
         return False
-    group = modifier(obj).node_group
+    group = mod.node_group
     offsets = group.get("kodawari_offsets", (0.0, 0.0))
     rows = _rows(table, _row_buffer, tuple(offsets), tuple(group.get("kodawari_signs", (1.0, 1.0))))
     for k, name in enumerate(FIELDS):
