@@ -482,11 +482,13 @@ class ArmatureRuntime:
             return None
         return matrices, armature_matrix, camera_position, _gravity(scene)
 
-    def _start_ahead(self, scene, frame, fps):
+    def _start_ahead(self, scene, frame, fps, after_reset=False):
         """Starts solving `frame` (the one after the frame just solved) on native threads from
         its predicted inputs, while Blender evaluates the frame just written (docs/algorithms.md
         §3.7). Nothing of it is used unless _take_ahead finds it is exactly what `frame` would
-        solve. Skipped past the scene's end (playback wraps to the start, which resets)."""
+        solve. Skipped past the scene's end (playback wraps to the start, which resets).
+        `after_reset`: started after the pass of the start frame (_start_after_reset), whose
+        state is already cached: no snapshot, and its caller share says nothing of the cores."""
         self.ahead_inputs = None
         if frame > scene.frame_end or len(self.rod_bones) < AHEAD_MIN_ROD_BONES:
             return
@@ -509,11 +511,14 @@ class ArmatureRuntime:
                 gravity,
                 frame / fps,
                 1 / fps,
-                self.rotations,  # the frame just solved: cached from the thread's snapshot (_store)
+                # the frame just solved: cached from the thread's snapshot (_store); after a
+                # reset it is cached already
+                None if after_reset else self.rotations,
             )
         except ValueError:
             return  # inputs the solver refuses: the frame itself says so if it is ever played
-        self.ahead_inputs = (frame, frame - 1, inputs, fps)  # stepped from the frame just solved
+        # stepped from the frame just solved
+        self.ahead_inputs = (frame, frame - 1, inputs, fps, after_reset)
 
     def _take_ahead(self, frame, previous, inputs, fps):
         """True when the frame solved ahead (_start_ahead) is `frame`, stepped from the state this
@@ -523,7 +528,7 @@ class ArmatureRuntime:
         ahead, self.ahead_inputs = self.ahead_inputs, None
         if ahead is None:
             return False
-        ahead_frame, ahead_previous, ahead_inputs, ahead_fps = ahead
+        ahead_frame, ahead_previous, ahead_inputs, ahead_fps, after_reset = ahead
         if (
             ahead_frame != frame
             or ahead_previous != previous
@@ -533,7 +538,10 @@ class ArmatureRuntime:
         ):
             return False
         finished = self.ahead.finish(self.rotations)
-        if self.ahead.caller_share > AHEAD_MAX_CALLER_SHARE:
+        # Started after the start frame's pass, the step had no pass to hide in, only what came
+        # after it (in playback, the wait for the next frame): its share is no sign of a busy
+        # machine.
+        if not after_reset and self.ahead.caller_share > AHEAD_MAX_CALLER_SHARE:
             self.ahead_paused = range(frame + 1, frame + 1 + AHEAD_PAUSE_FRAMES)
         return finished and self.ahead.adopt(self.system)
 
@@ -705,7 +713,8 @@ class ArmatureRuntime:
             _replay(scene, scene.frame_start if previous is None else previous + 1, frame)
             return
         armature_matrix, camera, gravity = self._inputs(obj, scene, frame, depsgraph)
-        if frame <= scene.frame_start or previous is None:
+        reset = frame <= scene.frame_start or previous is None
+        if reset:
             self.predictor, self.prediction_off = None, None  # looked at afresh from the start
             self.system.clear_cache()
             self.system.reset(
@@ -716,6 +725,30 @@ class ArmatureRuntime:
         self.system.store_frame(frame, self.rotations)
         self.last_frame = frame
         self._write(obj, depsgraph)
+        if reset and frame == scene.frame_start:
+            self._start_after_reset(obj, scene, frame, depsgraph)
+
+    def _start_after_reset(self, obj, scene, frame, depsgraph):
+        """After the start frame's pass (playback starting or looping): the next frame is started
+        ahead now, on native threads, so that it is solved while the start frame shows and
+        playback waits for the next frame's time, not on that frame's path (docs/algorithms.md
+        §3.7). The rig is looked at for the prediction here (PosePredictor), once a playback, as
+        the next frame would do. Only where the next frame would be solved ahead anyway (big
+        rigs, the viewport's own evaluation, whole frames)."""
+        if (
+            len(self.rod_bones) < AHEAD_MIN_ROD_BONES
+            or scene.frame_subframe
+            or not _can_replay(depsgraph)
+            or self.prediction_off is not None
+        ):
+            return
+        if self.predictor is None:
+            try:
+                self.predictor = predict.PosePredictor(obj, self.input_bones, self.written_bones)
+            except predict.Unpredictable as exc:
+                self.prediction_off = str(exc)
+                return
+        self._start_ahead(scene, frame + 1, _fps(scene), True)  # after_reset
 
     def weights(self, rod_index):
         slot = self.rod_slots.get(rod_index)
