@@ -387,7 +387,8 @@ PHASES = (
 
 def breakdown(sides, frames):
     """ms per frame of each phase in one more round of the kodawari side, and Blender's pass
-    (the frame minus both handlers)."""
+    (the frame minus both handlers); the cores the process used in that round and in one round
+    of the bare rig."""
     from kodawari.hair import runtime
 
     spent = dict.fromkeys((label for _, _, label in PHASES), 0.0)
@@ -412,10 +413,10 @@ def breakdown(sides, frames):
 
         setattr(target, name, timed)
     try:
-        start = time.perf_counter()
+        start, start_cpu = time.perf_counter(), time.process_time()
         for frame in frames:
             sides.frame(frame)
-        total = time.perf_counter() - start
+        total, total_cpu = time.perf_counter() - start, time.process_time() - start_cpu
     finally:
         for target, name, original in originals:
             setattr(target, name, original)
@@ -426,6 +427,19 @@ def breakdown(sides, frames):
     )
     for label in ("pre: all", "post: all"):
         out[f"{label}, main-thread CPU"] = round(cpu[label] / len(frames) * 1e3, 2)
+    # How many cores the process had: its processor time (every thread) over the wall time of the
+    # same frames, here and for the bare rig right after. Near 1 the machine left the process one
+    # core (other work held the other): the step ahead then adds its whole processor time.
+    out["cores used (process CPU / wall)"] = round(total_cpu / total, 2)
+    sides.use("bare")
+    sides.frame(1)
+    start, start_cpu = time.perf_counter(), time.process_time()
+    for frame in frames:
+        sides.frame(frame)
+    bare, bare_cpu = time.perf_counter() - start, time.process_time() - start_cpu
+    sides.use(None)
+    out["bare frame"] = round(bare / len(frames) * 1e3, 2)
+    out["bare: cores used"] = round(bare_cpu / bare, 2)
     return out
 
 
