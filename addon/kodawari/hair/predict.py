@@ -11,6 +11,7 @@ post-evaluation path. The prediction is checked against Blender's evaluation aft
 (`matches`); a wrong one is thrown away and solved again from the true inputs.
 """
 
+import operator
 import re
 
 import numpy as np
@@ -32,6 +33,7 @@ INHERIT_SCALE = {"FULL": 0, "AVERAGE": 1, "NONE": 2, "NONE_LEGACY": 3}
 # A prediction holds when every input is within this of Blender's (relative above 1): Blender
 # evaluates in float32 (about 1e-7 relative), the native forward kinematics in float64.
 TOLERANCE = 1e-6
+_CONSTRAINTS = operator.attrgetter("constraints")
 _BONE_PATH = re.compile(r'^pose\.bones\["((?:[^"\\]|\\.)*)"\]\.(\w+)$')
 # Pose-bone channels: (property, first column in the channel row, value count).
 _BONE_CHANNELS = {
@@ -196,10 +198,9 @@ class PosePredictor:
             while bone is not None and index[bone.name] not in needed:
                 needed.add(index[bone.name])
                 bone = bone.parent
-        _refuse_constraints(pose_bones, index, needed)
-        _refuse_drivers(
-            obj, "the armature", {names[i] for i in needed} | {names[i] for i in written_bones}
-        )
+        _refuse_constraints(pose_bones, names, index, needed)
+        written = {names[i] for i in written_bones}
+        _refuse_drivers(obj, "the armature", {names[i] for i in needed} | written)
         order = sorted(needed, key=lambda i: (_depth(pose_bones[i]), i))
         position = {b: k for k, b in enumerate(order)}
         self.bones = [pose_bones[i] for i in order]
@@ -231,7 +232,6 @@ class PosePredictor:
         self.inherit_scale = np.array(inherit_scale, np.int32)
         self.rotation_properties = [_rotation_property(pb.rotation_mode) for pb in self.bones]
         # F-curves of the bones in the chain (bone row, first column, fcurve), and refusals.
-        written = {names[i] for i in written_bones}
         self.curves = []
         for fc in _evaluated_curves(obj, "the armature"):
             match = _BONE_PATH.match(fc.data_path)
@@ -288,16 +288,19 @@ class PosePredictor:
         return matrices.astype(np.float32), self.motion.matrix(time)
 
 
-def _refuse_constraints(pose_bones, index, needed):
+def _refuse_constraints(pose_bones, names, index, needed):
     """Raises when a constraint can move one of the `needed` bones (the rods' inputs and their
     ancestors): a constraint on one of them, or an IK or Spline IK chain reaching one of them
     from a bone below (chain length 0: to the root). Constraints elsewhere (an IK leg, a
-    constrained prop) move only their own bones and those below."""
-    for pb in pose_bones:
-        constraints = pb.constraints
+    constrained prop) move only their own bones and those below. `names`: pose_bones.keys(),
+    in the same order (every bone is looked at once a playback: at 16,000 bones this walk is
+    most of PosePredictor's set-up, so a bone's name is asked for only when it has
+    constraints)."""
+    for i, constraints in enumerate(map(_CONSTRAINTS, pose_bones)):
         if not len(constraints):
             continue
-        if index[pb.name] in needed:
+        pb = pose_bones[names[i]]
+        if i in needed:
             raise Unpredictable(f"bone '{pb.name}' has constraints")
         for con in constraints:
             if con.type not in ("IK", "SPLINE_IK"):
