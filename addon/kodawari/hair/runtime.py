@@ -726,7 +726,10 @@ class ArmatureRuntime:
         self.last_frame = frame
         self._write(obj, depsgraph)
         if reset and frame == scene.frame_start:
-            self._start_after_reset(obj, scene, frame, depsgraph)
+            try:
+                self._start_after_reset(obj, scene, frame, depsgraph)
+            except Exception:  # noqa: BLE001 - only a head start: the next frame's own path runs
+                self.ahead_inputs = None  # and reports what is wrong (show_cached_frames alike)
 
     def _start_after_reset(self, obj, scene, frame, depsgraph):
         """After the start frame's pass (playback starting or looping): the next frame is started
