@@ -10,9 +10,10 @@ then the depsgraph evaluates whatever the frame handlers tagged.
                 and written before Blender evaluates it (frame_change_pre), Blender's evaluation,
                 the prediction checked against it (frame_change_post); one evaluation. On rigs of
                 4,096 rod bones or more the frame was solved ahead, on native threads, while
-                Blender evaluated the frame before (runtime.AHEAD_MIN_ROD_BONES); frames set back
-                to back, as here, leave that solve only Blender's evaluation to hide in (in real
-                playback it also has the viewport's drawing and the wait for the next frame)
+                Blender evaluated the frame before (runtime.AHEAD_MIN_ROD_BONES; the first new
+                frame once the start frame's pass was over); frames set back to back, as here,
+                leave that solve only Blender's evaluation to hide in (in real playback it also has
+                the viewport's drawing and the wait for the next frame)
   kodawari_inline  the same, every frame solved in its own frame_change_pre (nothing solved ahead:
                 the path before, and of rigs below the size above)
   kodawari_post the same frames solved after Blender's evaluation instead (prediction off, the
