@@ -303,6 +303,34 @@ def test_a_file_saved_with_the_packed_float3_binding_swims_again(empty_scene):
     assert np.array_equal(rest(obj), original)
 
 
+def test_the_frame_helper_holds_only_the_rows_the_tree_reads(empty_scene):
+    # Where no vertex lies past an end of the axis the tree never reads e1 or its change:
+    # the helper holds six rows a segment, not eight (a quarter less written every frame).
+    # A helper holding all eight (installed before) still swims exactly, all eight written.
+    set_fps(24)
+    obj = make_fish("tuna")
+    add_swim(obj, head_axis="POS_X", frequency=2.0)
+    from kodawari.fish import route, runtime
+
+    mod = route.modifier(obj)
+    table = route.helpers(mod)[0]
+    rows = {a.name for a in table.attributes if a.name in route.FIELDS}
+    assert rows == {"o", "do", "e2", "de2", "e3", "de3"}
+    worst, moved = _route_equals_core(obj, (3, 5))
+    assert moved > 0.02 and worst < 1e-5
+    for name in ("e1", "de1"):  # what an installation from before held
+        table.attributes.new(name, "FLOAT_VECTOR", "POINT")
+    worst, moved = _route_equals_core(obj, (4, 6))
+    assert moved > 0.02 and worst < 1e-5
+    written = np.empty(route.ROWS * 3, np.float32)
+    table.attributes["e1"].data.foreach_get("vector", written)
+    assert np.abs(written).max() > 0.5, "its e1 row is written too"
+    runtime.forget(obj)  # a file opened: bound and installed again, with six rows
+    worst, _ = _route_equals_core(obj, (7,))
+    table = route.helpers(route.modifier(obj))[0]
+    assert worst < 1e-5 and {a.name for a in table.attributes if a.name in route.FIELDS} == rows
+
+
 def test_a_straight_axis_fish_stores_only_its_parameter(empty_scene):
     # Along a straight rest axis u and v are the rest position's offsets across it, an affine
     # function of Position, measured on every vertex at bind time (docs/algorithms.md §1.6);

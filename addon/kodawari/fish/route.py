@@ -34,6 +34,12 @@ FIELDS = ("o", "do", "e1", "de1", "e2", "de2", "e3", "de3")  # rows of AxisBindi
 REST = "rest_"  # the rest table's fields, read only when the mesh has shape keys
 
 
+def sampled_fields(with_ends):
+    """The table's fields the tree samples: e1 and its change only where some vertex lies
+    past an end of the axis (w != 0); the helper holds and the handler writes only these."""
+    return FIELDS if with_ends else tuple(f for f in FIELDS if not f.endswith("e1"))
+
+
 def modifier(obj):
     """The object's Fish Swim modifier: the Geometry Nodes modifier running our group (found
     by the group's mark, so a renamed modifier is still the swim)."""
@@ -177,7 +183,7 @@ def build_group(
     # t = 1024 (the tail) reads the last row, the tail's frame, at fraction 0.
     segment = tree.math("FLOOR", t, 0.0)
     fraction = tree.math("SUBTRACT", t, segment)
-    fields = FIELDS if with_ends else tuple(f for f in FIELDS if not f.endswith("e1"))
+    fields = sampled_fields(with_ends)
 
     def bend(prefix):
         row = {name: tree.sample(table, prefix + name, segment) for name in fields}
@@ -348,12 +354,15 @@ def install(obj, rig):
     del packed
     if mesh.attributes.get(PACKED) is not None:
         mesh.attributes.remove(mesh.attributes[PACKED])
-    rest_fields = tuple(REST + f for f in FIELDS) if with_keys else ()
-    table_obj = _helper_object(TABLE, ROWS, FIELDS + rest_fields)
+    fields = sampled_fields(with_ends)
+    rest_fields = tuple(REST + f for f in fields) if with_keys else ()
+    table_obj = _helper_object(TABLE, ROWS, fields + rest_fields)
     if with_keys:
         rest_rows = _rows(rig.rest_table(), np.empty((len(FIELDS), ROWS, 3), np.float32))
-        for k, name in enumerate(rest_fields):
-            table_obj.data.attributes[name].data.foreach_set("vector", rest_rows[k].reshape(-1))
+        for k, name in enumerate(FIELDS):
+            if REST + name in rest_fields:
+                attribute = table_obj.data.attributes[REST + name]
+                attribute.data.foreach_set("vector", rest_rows[k].reshape(-1))
     fins_obj = None
     if rig.fin_vertices is not None:
         index = np.full(len(mesh.vertices), -1, np.int32)
@@ -432,8 +441,13 @@ def write_frame(obj, table, fin_offsets):
     group = mod.node_group
     offsets = group.get("kodawari_offsets", (0.0, 0.0))
     rows = _rows(table, _row_buffer, tuple(offsets), tuple(group.get("kodawari_signs", (1.0, 1.0))))
+    attributes = table_mesh.attributes
     for k, name in enumerate(FIELDS):
-        table_mesh.attributes[name].data.foreach_set("vector", rows[k].reshape(-1))
+        # Only the fields the tree samples are in the helper (sampled_fields; a file saved
+        # before holds all eight, and gets all eight).
+        attribute = attributes.get(name)
+        if attribute is not None:
+            attribute.data.foreach_set("vector", rows[k].reshape(-1))
     table_mesh.update_tag()
     if (
         fins_mesh is not None
