@@ -254,6 +254,41 @@ def build_side(side, scene, ring, rings, axes=None, rest_axis=None, frames=(), m
 # ----------------------------------------------------------------------------- one frame
 
 
+def detach_frame_handler():
+    """Takes the swim's frame handler out of frame_change_post, for benchmarks that write the
+    frames themselves (so no copy is bound again by it); put it back with post.append."""
+    post = bpy.app.handlers.frame_change_post
+    handler = next(h for h in post if getattr(h, "__name__", "") == "on_frame_change")
+    post.remove(handler)
+    return handler
+
+
+def frame_tables(fish, scene, frames):
+    """Each frame's table (the core's, as the live handler computes it), computed once."""
+    from kodawari.fish import runtime, timing
+
+    rig = runtime.get_rig(fish)
+    settings = fish.kodawari_swim
+    tables = {}
+    for frame in frames:
+        phase, _ = timing.phase_and_distance(fish, settings, scene, frame, rig.body_length)
+        tables[frame] = rig.frame(settings, phase)[0].copy()
+    return rig, tables
+
+
+def copy_in_own_scene(fish, name, node_group):
+    """A copy of the fish (same mesh) in a scene of its own whose Fish Swim runs `node_group`:
+    a frame there evaluates that tree alone, and no group is swapped while timing."""
+    from kodawari.fish import route
+
+    scene = new_scene(name)
+    obj = fish.copy()
+    scene.collection.objects.link(obj)
+    route.modifier(obj).node_group = node_group
+    scene.frame_set(1)  # makes the scene's depsgraph
+    return scene, obj
+
+
 def whole_frame(scene, obj, frame):
     """What a viewport does per frame: frame_set, evaluate what handlers tagged, read normals.
     Returns the tail vertex of the evaluated mesh (to check that it moves)."""

@@ -139,23 +139,16 @@ def new_group(name, table_obj, body):
 
 
 def measure(ring, rings):
-    from kodawari.fish import route, runtime, timing
+    from kodawari.fish import route
 
     bpy.ops.wm.read_homefile(use_empty=True)
     scene = bpy.context.scene
     scene.render.fps = 24
     frames = list(range(1, FRAMES + 2))
     fish = bench_fish.build_side("kodawari", scene, ring, rings)
-    post = bpy.app.handlers.frame_change_post
-    handler = next(h for h in post if getattr(h, "__name__", "") == "on_frame_change")
-    post.remove(handler)  # the copies are driven here, not bound again by the handler
+    handler = bench_fish.detach_frame_handler()  # the copies are driven here
     try:
-        rig = runtime.get_rig(fish)
-        settings = fish.kodawari_swim
-        tables = {}
-        for frame in frames:
-            phase, _ = timing.phase_and_distance(fish, settings, scene, frame, rig.body_length)
-            tables[frame] = rig.frame(settings, phase)[0].copy()
+        rig, tables = bench_fish.frame_tables(fish, scene, frames)
         swim = route.modifier(fish).node_group
         table_obj = swim.nodes["frames"].inputs[0].default_value
         computed = swim.get("kodawari_stored") == "s"  # u and v from Position: matrix applies
@@ -185,12 +178,7 @@ def measure(ring, rings):
             trees["matrix"] = (lambda: new_group("matrix", matrix_obj, matrix_group), write_matrix)
         copies = {}
         for kind, (make, writer) in trees.items():
-            part_scene = bench_fish.new_scene(kind)
-            obj = fish.copy()
-            part_scene.collection.objects.link(obj)
-            route.modifier(obj).node_group = make()
-            part_scene.frame_set(1)  # makes the scene's depsgraph
-            copies[kind] = (part_scene, obj, writer)
+            copies[kind] = (*bench_fish.copy_in_own_scene(fish, kind, make()), writer)
         # Same shape: the matrix tree against the Fish Swim tree, at one frame.
         shapes = {}
         for kind in ("fish_swim", "matrix"):
@@ -229,7 +217,7 @@ def measure(ring, rings):
 
         rows = benchlib.Rounds(rounds=5).run({kind: player(kind) for kind in copies})
     finally:
-        post.append(handler)
+        bpy.app.handlers.frame_change_post.append(handler)
     return rows, matrix_error
 
 

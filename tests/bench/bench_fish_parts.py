@@ -81,7 +81,7 @@ def cpu_per_frame(frame_once):
 
 
 def measure(ring, rings):
-    from kodawari.fish import route, runtime, timing
+    from kodawari.fish import route, runtime
 
     bpy.ops.wm.read_homefile(use_empty=True)
     scene = bpy.context.scene
@@ -99,27 +99,14 @@ def measure(ring, rings):
         others[side] = (other_scene, obj)
     bpy.data.meshes.remove(body)
     # The evaluation parts are driven here, not by the frame handler.
-    post = bpy.app.handlers.frame_change_post
-    handler = next(h for h in post if getattr(h, "__name__", "") == "on_frame_change")
-    post.remove(handler)
-    rig = runtime.get_rig(fish)
-    settings = fish.kodawari_swim
-    tables = {}
-    for frame in frames:
-        phase, _ = timing.phase_and_distance(fish, settings, scene, frame, rig.body_length)
-        tables[frame] = rig.frame(settings, phase)[0].copy()
+    handler = bench_fish.detach_frame_handler()
+    rig, tables = bench_fish.frame_tables(fish, scene, frames)
     swim_group = route.modifier(fish).node_group
     table_obj = swim_group.nodes["frames"].inputs[0].default_value
-    # Each cut-down tree on its own copy of the fish (same mesh) in its own scene, so a
-    # frame evaluates that part alone and no node group is swapped while timing.
+    # Each cut-down tree on its own copy of the fish.
     parts = {"fish_swim": (scene, fish)}
     for part in TREE_PARTS[:-1]:
-        part_scene = bench_fish.new_scene(part)
-        obj = fish.copy()
-        part_scene.collection.objects.link(obj)
-        route.modifier(obj).node_group = cut_down_group(table_obj, part)
-        part_scene.frame_set(1)  # makes the scene's depsgraph
-        parts[part] = (part_scene, obj)
+        parts[part] = bench_fish.copy_in_own_scene(fish, part, cut_down_group(table_obj, part))
 
     # The whole tree as it was before u and v could be computed: all three read.
     stored_obj = fish.copy()
@@ -169,7 +156,7 @@ def measure(ring, rings):
     plays["+ normals"] = cpu_per_frame(tree_frame("fish_swim", normals=True))
     plays.update({side: cpu_per_frame(other_frame(side)) for side in others})
     rows = benchlib.Rounds(rounds=5).run(plays)
-    post.append(handler)
+    bpy.app.handlers.frame_change_post.append(handler)
     return rows
 
 
