@@ -49,8 +49,29 @@ void deform(benchmark::State& state, unsigned threads) {
       benchmark::Counter(double(count), benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
 }
 
+// What the add-on runs for a bake or Apply: the packed (s, u, v) coordinates the mesh keeps
+// (docs/algorithms.md §1.6), the frame table made once per frame as the handler does.
+void deform_packed_coordinates(benchmark::State& state, unsigned threads) {
+  const std::size_t count = static_cast<std::size_t>(state.range(0));
+  const std::vector<float> vertices = body(count);
+  const AxisBinding binding(axis(0), vertices.data(), count, {}, std::nullopt);
+  const float end_scale = 1.0f;
+  std::vector<float> packed(3 * count), out(3 * count);
+  binding.packed_coordinates(end_scale, packed.data());
+  FrameTable table;
+  binding.frame_table(axis(1.3), {}, std::nullopt, table);
+  for (auto _ : state) {
+    deform_packed(table, packed.data(), count, end_scale, out.data(), threads);
+    benchmark::DoNotOptimize(out.data());
+  }
+  state.counters["ns_per_vertex"] =
+      benchmark::Counter(double(count), benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+}
+
 void BM_DeformAllCores(benchmark::State& state) { deform(state, 0); }
 void BM_DeformOneThread(benchmark::State& state) { deform(state, 1); }
+void BM_DeformPackedAllCores(benchmark::State& state) { deform_packed_coordinates(state, 0); }
+void BM_DeformPackedOneThread(benchmark::State& state) { deform_packed_coordinates(state, 1); }
 
 void BM_Bind(benchmark::State& state) {
   const std::size_t count = static_cast<std::size_t>(state.range(0));
@@ -76,6 +97,8 @@ void BM_FrameTable(benchmark::State& state) {
 
 BENCHMARK(BM_DeformAllCores)->Arg(10'000)->Arg(100'000)->Arg(1'000'000)->Arg(4'000'000)->Unit(benchmark::kMicrosecond)->UseRealTime();
 BENCHMARK(BM_DeformOneThread)->Arg(10'000)->Arg(100'000)->Arg(1'000'000)->Arg(4'000'000)->Unit(benchmark::kMicrosecond)->UseRealTime();
+BENCHMARK(BM_DeformPackedAllCores)->Arg(100'000)->Arg(1'000'000)->Unit(benchmark::kMicrosecond)->UseRealTime();
+BENCHMARK(BM_DeformPackedOneThread)->Arg(100'000)->Arg(1'000'000)->Unit(benchmark::kMicrosecond)->UseRealTime();
 BENCHMARK(BM_Bind)->Arg(100'000)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_FrameTable)->Unit(benchmark::kMicrosecond)->UseRealTime();
 BENCHMARK_MAIN();

@@ -277,9 +277,11 @@ void deform_packed(const FrameTable& table, const float* packed, std::size_t cou
     for (std::size_t i = begin; i < end; ++i) {
       const float s = packed[3 * i];
       const float t = std::clamp(s, 0.0f, last);
-      const float segment = std::min(std::floor(t), last - 1.0f);
+      // t >= 0, so truncation is the floor (std::floor is a libm call on baseline x86-64).
+      const std::uint32_t whole = std::min<std::uint32_t>(static_cast<std::uint32_t>(t), kTableSegments - 1);
+      const float segment = static_cast<float>(whole);
       AxisCoordinate c;
-      c.segment = static_cast<std::uint32_t>(segment);
+      c.segment = whole;
       c.fraction = t - segment;
       c.u = packed[3 * i + 1];
       c.v = packed[3 * i + 2];

@@ -46,10 +46,19 @@ inline TableFrame table_frame(const TableSegment& s, float f) {
   return {s.origin + f * s.d_origin, s.e1 + f * s.d_e1, s.e2 + f * s.d_e2, s.e3 + f * s.d_e3};
 }
 
+// Inlined into every per-vertex loop: a call per vertex (its coordinate passed through
+// memory) cost 2-3x the arithmetic (bench_ffd, DeformPacked).
+#if defined(__GNUC__) || defined(__clang__)
+#define KODAWARI_ALWAYS_INLINE inline __attribute__((always_inline))
+#elif defined(_MSC_VER)
+#define KODAWARI_ALWAYS_INLINE __forceinline
+#else
+#define KODAWARI_ALWAYS_INLINE inline
+#endif
 // P' = M(t) + u e2 + v e3 + w e1 (docs/algorithms.md §1.4, plus w beyond the ends),
 // with the frame interpolated linearly within the segment. Four-lane float
 // arithmetic, the same for every vertex whichever thread computes it.
-inline void deform_vertex(const TableSegment& s, const AxisCoordinate& c, float* out) {
+KODAWARI_ALWAYS_INLINE void deform_vertex(const TableSegment& s, const AxisCoordinate& c, float* out) {
   const float f = c.fraction;
   const Vec4f p = (s.origin + c.u * s.e2 + c.v * s.e3 + c.w * s.e1) +
                   f * (s.d_origin + c.u * s.d_e2 + c.v * s.d_e3 + c.w * s.d_e1);
