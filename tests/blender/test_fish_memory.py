@@ -87,6 +87,32 @@ def test_add_fish_swim_binds_the_mesh_once(empty_scene, monkeypatch):
     assert binds == [obj.name]
 
 
+def test_the_frame_after_add_fish_swim_returns_the_setups_freed_memory(empty_scene, monkeypatch):
+    # Add Fish Swim reads the mesh and binds it: tens of bytes per vertex of scratch, the
+    # last of it freed only when the operator returns. glibc keeps freed memory resident
+    # until asked to give it back: at 1 M vertices 20-25 MB, the swim's whole lead over the
+    # Geometry Nodes bend's peak while playing (docs/algorithms.md §1.6). The frame after
+    # the setup asks once; later frames do not. (The resident size itself moves by more
+    # than that between runs of one process, so the request is what is checked.)
+    from kodawari.fish import runtime
+
+    set_fps(24)
+    obj = make_fish("tuna")
+    add_swim(obj, head_axis="POS_X", preset="CARANGIFORM", frequency=2.0)
+    native = runtime.get_rig(obj).kn
+    asked = []
+    release = native.release_free_memory
+
+    def counted():
+        asked.append(bpy.context.scene.frame_current)
+        return release()
+
+    monkeypatch.setattr(native, "release_free_memory", counted)
+    for frame in (2, 3, 4):
+        bpy.context.scene.frame_set(frame)
+    assert asked == [2]
+
+
 def _blender_memory_mb():
     """Blender's own memory in use (its allocator's count, exact to the kB; what
     Window > Memory Statistics prints), read from that operator's report on stdout."""

@@ -54,6 +54,7 @@ def on_frame_change(scene, depsgraph=None):
             problems.report(obj, "swim", exc)
         else:
             problems.clear(obj, "swim")
+    runtime.release_setup_scratch()
 
 
 @persistent
