@@ -40,6 +40,20 @@ def test_without_keys_and_gravity_the_chain_settles_back_to_rest_after_the_head_
     np.testing.assert_allclose(chain.positions(), chain.rest_positions([IDENTITY] * 6), atol=2e-3)
 
 
+def test_a_far_move_over_a_vanishing_frame_step_keeps_the_state_finite():
+    # The head's speed is its move over the frame's step: 3e8 over 1e-300 s overflowed to
+    # inf and was kept in the saved state (found by the fuzz tier). Finite inputs must give
+    # a finite state, and the chain must go on stepping normally from it.
+    chain = Chain()
+    chain.reset()
+    chain.head_position = np.array([3e8, 0.0, 0.0])
+    chain.step(dt=1e-300)
+    assert np.isfinite(chain.system.save_state()).all()
+    chain.head_position = np.array([3e8, 0.1, 0.0])
+    chain.step()
+    assert np.isfinite(chain.system.save_state()).all() and np.isfinite(chain.positions()).all()
+
+
 def test_camera_on_a_keyed_direction_with_large_influence_settles_on_that_key_within_2_degrees():
     shape = curl((0, 0, 1), 15)
     chain = Chain(keys=[dict(condition=0, direction=(1, 0, 0), influence=64.0, shape=shape)])

@@ -4,6 +4,7 @@
 #include "kodawari/rod/rod_system.hpp"
 
 #include <algorithm>
+#include <limits>
 
 #include "kodawari/rod/view_weights.hpp"
 #include "rod_detail.hpp"
@@ -57,8 +58,12 @@ void RodSystem::begin_frame(std::size_t r, const FrameInput& input, const std::v
   Vec3 ref_position;
   bone_transform(input.bone_matrices, static_cast<std::size_t>(rod.reference_bone), ref_rotation, ref_position);
   const Vec3 ref_world = arm_linear * ref_position + arm_translation;
-  s.speed = (s.initialised && !reset && input.frame_dt > 0) ? (ref_world - s.reference_position).norm() / input.frame_dt
-                                                            : Real(0);
+  const Real speed = (s.initialised && !reset && input.frame_dt > 0)
+                         ? (ref_world - s.reference_position).norm() / input.frame_dt
+                         : Real(0);
+  // A far move over a tiny step (a subframe) overflows to inf: the state stays finite, and
+  // the largest speed weighs a speed key as inf did (speed_similarity gives 0).
+  s.speed = speed <= std::numeric_limits<Real>::max() ? speed : std::numeric_limits<Real>::max();
   s.reference_position = ref_world;
   bool has_view = false;
   Vec3 view = Vec3::Zero();
