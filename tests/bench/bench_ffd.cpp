@@ -35,6 +35,12 @@ std::vector<float> body(std::size_t count) {
   return vertices;
 }
 
+// Reports the time per vertex beside the time per call.
+void per_vertex(benchmark::State& state, std::size_t count) {
+  state.counters["ns_per_vertex"] =
+      benchmark::Counter(double(count), benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+}
+
 void deform(benchmark::State& state, unsigned threads) {
   const std::size_t count = static_cast<std::size_t>(state.range(0));
   const std::vector<float> vertices = body(count);
@@ -45,8 +51,7 @@ void deform(benchmark::State& state, unsigned threads) {
     binding.deform(bent, {}, std::nullopt, out.data(), threads);
     benchmark::DoNotOptimize(out.data());
   }
-  state.counters["ns_per_vertex"] =
-      benchmark::Counter(double(count), benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+  per_vertex(state, count);
 }
 
 // What the add-on runs for a bake or Apply: the packed (s, u, v) coordinates the mesh keeps
@@ -64,8 +69,7 @@ void deform_packed_coordinates(benchmark::State& state, unsigned threads) {
     deform_packed(table, packed.data(), count, end_scale, out.data(), threads);
     benchmark::DoNotOptimize(out.data());
   }
-  state.counters["ns_per_vertex"] =
-      benchmark::Counter(double(count), benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+  per_vertex(state, count);
 }
 
 void BM_DeformAllCores(benchmark::State& state) { deform(state, 0); }
@@ -80,8 +84,7 @@ void BM_Bind(benchmark::State& state) {
     AxisBinding binding(axis(0), vertices.data(), count, {}, std::nullopt);
     benchmark::DoNotOptimize(binding.coordinates().data());
   }
-  state.counters["ns_per_vertex"] =
-      benchmark::Counter(double(count), benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+  per_vertex(state, count);
 }
 
 // The fixed per-call cost: sampling the moved curve and its frames (1025 samples).

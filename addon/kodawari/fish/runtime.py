@@ -14,7 +14,7 @@ import contextlib
 import bpy
 import mathutils
 
-from .. import problems
+from .. import native, problems
 from . import path, route, timing, visibility
 from . import rig as rig_module
 
@@ -22,7 +22,7 @@ SHAPE_KEY = rig_module.SHAPE_KEY
 
 _rigs = {}
 _batch_depth = {}
-_scratch_pending = set()  # the native module, when a setup left freed scratch behind
+_setup_left_scratch = False  # a route was installed since the last frame
 
 
 def _key(obj):
@@ -143,6 +143,7 @@ def drop_swim_key(obj):
 
 def ensure_route(obj, rig):
     """The route installed for this rig's binding (installed again after a rebind)."""
+    global _setup_left_scratch
     if route.installed_for(obj, rig):
         return
     drop_swim_key(obj)
@@ -153,14 +154,16 @@ def ensure_route(obj, rig):
     # calling operator still holds (its reads of the mesh) is freed only when it returns, so
     # once more on the next frame (release_setup_scratch).
     rig.kn.release_free_memory()
-    _scratch_pending.add(rig.kn)
+    _setup_left_scratch = True
 
 
 def release_setup_scratch():
     """Once after a route was installed, from the frame handler: the memory the setup freed
     since (25 MB at 1 M vertices) goes back to the system instead of staying resident."""
-    while _scratch_pending:
-        _scratch_pending.pop().release_free_memory()
+    global _setup_left_scratch
+    if _setup_left_scratch:
+        _setup_left_scratch = False
+        native.module().release_free_memory()
 
 
 def travel_direction(obj, rig):
